@@ -1,0 +1,59 @@
+#include "cli/mesh_input.h"
+
+#include "formats/mesh_io.h"
+
+namespace polycube::cli {
+
+void add_mesh_input_options(CLI::App& command, MeshInput& input) {
+  command.add_option("FILE", input.path, "Input mesh (.obj .off .ply .stl)")->required();
+  command.add_flag("--fill-holes", input.prepare.fill_holes, "Close boundary loops (CGAL hole filling)");
+  command.add_flag("--largest-component", input.prepare.largest_component, "Keep only the largest component");
+  command.add_flag_callback(
+      "--no-self-intersections", [&input] { input.prepare.check_self_intersections = false; },
+      "Skip the self-intersection check");
+}
+
+PreparedMesh load_mesh(const MeshInput& input, const Progress& progress) {
+  progress.stage("read", input.path);
+  const PolygonSoup soup = read_polygon_soup(input.path);
+  progress.stage("validate", std::to_string(soup.points.size()) + " vertices, " +
+                                 std::to_string(soup.polygons.size()) + " faces");
+  PreparedMesh prepared = prepare_mesh(soup, input.prepare);
+  for (const std::string& repair : prepared.repairs) progress.warning(repair);
+  for (const std::string& warning : prepared.diagnosis.warnings) progress.warning(warning);
+  return prepared;
+}
+
+nlohmann::json diagnosis_json(const PreparedMesh& prepared) {
+  const MeshDiagnosis& d = prepared.diagnosis;
+  nlohmann::json j;
+  j["input_vertices"] = d.input_vertices;
+  j["input_faces"] = d.input_polygons;
+  j["vertices"] = d.vertices;
+  j["faces"] = d.faces;
+  j["edges"] = d.edges;
+  j["components"] = d.components;
+  j["boundary_loops"] = d.boundary_loops;
+  j["boundary_edges"] = d.boundary_edges;
+  j["nonmanifold_edges"] = d.nonmanifold_edges;
+  j["nonmanifold_vertices"] = d.nonmanifold_vertices;
+  j["manifold"] = d.manifold();
+  j["orientable"] = d.orientable;
+  j["closed"] = d.closed();
+  j["degenerate_faces"] = d.degenerate_faces;
+  j["self_intersections"] = d.self_intersections >= 0 ? nlohmann::json(d.self_intersections) : nlohmann::json();
+  j["euler"] = d.euler;
+  j["genus"] = d.genus ? nlohmann::json(*d.genus) : nlohmann::json();
+  if (d.vertices > 0) {
+    j["bounding_box"] = {{"min", {d.bbox.min.x(), d.bbox.min.y(), d.bbox.min.z()}},
+                         {"max", {d.bbox.max.x(), d.bbox.max.y(), d.bbox.max.z()}},
+                         {"diagonal", d.bbox.diagonal()}};
+  }
+  j["repairs"] = prepared.repairs;
+  j["problems"] = d.problems;
+  j["warnings"] = d.warnings;
+  j["valid"] = d.valid();
+  return j;
+}
+
+}  // namespace polycube::cli

@@ -1,0 +1,27 @@
+// Reading and preparing the input mesh, shared by every subcommand that takes one.
+#pragma once
+
+#include "cli/commands.h"
+#include "polycube/validate.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace polycube::cli {
+
+struct MeshInput {
+  std::string path;
+  PrepareOptions prepare;
+};
+
+// Adds FILE and the repair flags (--fill-holes, --largest-component, --no-self-intersections).
+void add_mesh_input_options(CLI::App& command, MeshInput& input);
+
+// Reads and prepares the mesh; reports each repair as a warning. Throws InputError.
+PreparedMesh load_mesh(const MeshInput& input, const Progress& progress);
+
+// The diagnosis as a JSON object (keys documented in README.md).
+nlohmann::json diagnosis_json(const PreparedMesh& prepared);
+
+}  // namespace polycube::cli

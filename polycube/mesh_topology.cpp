@@ -1,0 +1,168 @@
+#include "polycube/mesh_topology.h"
+
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+
+namespace polycube {
+
+namespace {
+
+// Union-find with path halving.
+struct DisjointSets {
+  std::vector<int> parent;
+  explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) { parent[find(a)] = find(b); }
+};
+
+}  // namespace
+
+EdgeMap build_edge_map(const Eigen::MatrixX3i& F) {
+  const int nf = static_cast<int>(F.rows());
+  // Sort half-edges by their undirected key; equal keys form one edge.
+  struct HalfEdge {
+    int a, b, face, corner;
+  };
+  std::vector<HalfEdge> halfedges;
+  halfedges.reserve(3 * nf);
+  for (int f = 0; f < nf; ++f)
+    for (int i = 0; i < 3; ++i) {
+      const int u = F(f, i), v = F(f, (i + 1) % 3);
+      halfedges.push_back({std::min(u, v), std::max(u, v), f, i});
+    }
+  std::sort(halfedges.begin(), halfedges.end(), [](const HalfEdge& x, const HalfEdge& y) {
+    return x.a != y.a ? x.a < y.a : x.b != y.b ? x.b < y.b : x.face < y.face;
+  });
+
+  EdgeMap map;
+  map.FE.resize(nf, 3);
+  std::vector<Eigen::Vector2i> edges, edge_faces;
+  std::vector<int> counts;
+  for (size_t i = 0; i < halfedges.size();) {
+    size_t j = i;
+    const int e = static_cast<int>(edges.size());
+    Eigen::Vector2i ef(-1, -1);
+    while (j < halfedges.size() && halfedges[j].a == halfedges[i].a && halfedges[j].b == halfedges[i].b) {
+      map.FE(halfedges[j].face, halfedges[j].corner) = e;
+      if (j - i < 2) ef[static_cast<int>(j - i)] = halfedges[j].face;
+      ++j;
+    }
+    edges.emplace_back(halfedges[i].a, halfedges[i].b);
+    edge_faces.push_back(ef);
+    counts.push_back(static_cast<int>(j - i));
+    i = j;
+  }
+  const int ne = static_cast<int>(edges.size());
+  map.E.resize(ne, 2);
+  map.EF.resize(ne, 2);
+  map.face_count.resize(ne);
+  for (int e = 0; e < ne; ++e) {
+    map.E.row(e) = edges[e].transpose();
+    map.EF.row(e) = edge_faces[e].transpose();
+    map.face_count[e] = counts[e];
+  }
+  return map;
+}
+
+std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixX3i& F) {
+  const EdgeMap map = build_edge_map(F);
+  // Directed boundary half-edges u -> v, keyed by their start vertex.
+  std::unordered_multimap<int, int> next;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int i = 0; i < 3; ++i)
+      if (map.face_count[map.FE(f, i)] == 1) next.emplace(F(f, i), F(f, (i + 1) % 3));
+
+  std::vector<std::vector<int>> loops;
+  while (!next.empty()) {
+    const int start = next.begin()->first;
+    std::vector<int> loop;
+    int current = start;
+    while (true) {
+      auto it = next.find(current);
+      if (it == next.end()) break;  // open chain (inconsistent orientation): stop here
+      loop.push_back(current);
+      current = it->second;
+      next.erase(it);
+      if (current == start) break;
+    }
+    if (!loop.empty()) loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+int connected_components(const Eigen::MatrixX3i& F, int num_vertices, Eigen::VectorXi* face_component) {
+  DisjointSets sets(num_vertices);
+  for (int f = 0; f < F.rows(); ++f) {
+    sets.unite(F(f, 0), F(f, 1));
+    sets.unite(F(f, 0), F(f, 2));
+  }
+  std::unordered_map<int, int> ids;
+  Eigen::VectorXi component(F.rows());
+  for (int f = 0; f < F.rows(); ++f) {
+    const int root = sets.find(F(f, 0));
+    auto [it, inserted] = ids.emplace(root, static_cast<int>(ids.size()));
+    component[f] = it->second;
+  }
+  if (face_component) *face_component = component;
+  return static_cast<int>(ids.size());
+}
+
+int count_nonmanifold_vertices(const Eigen::MatrixX3i& F, int num_vertices) {
+  // Around each vertex, faces sharing an edge through the vertex are linked; a manifold vertex
+  // has exactly one linked group of faces.
+  std::vector<std::vector<int>> vertex_faces(num_vertices);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int i = 0; i < 3; ++i) vertex_faces[F(f, i)].push_back(f);
+
+  int bad = 0;
+  for (int v = 0; v < num_vertices; ++v) {
+    const auto& faces = vertex_faces[v];
+    if (faces.size() <= 1) continue;
+    // Map each opposite-edge endpoint to the local faces containing it.
+    std::unordered_map<int, std::vector<int>> by_neighbour;
+    for (int k = 0; k < static_cast<int>(faces.size()); ++k)
+      for (int i = 0; i < 3; ++i)
+        if (F(faces[k], i) != v) by_neighbour[F(faces[k], i)].push_back(k);
+    DisjointSets local(static_cast<int>(faces.size()));
+    for (const auto& [neighbour, ks] : by_neighbour)
+      for (size_t j = 1; j < ks.size(); ++j) local.unite(ks[0], ks[j]);
+    int groups = 0;
+    for (int k = 0; k < static_cast<int>(faces.size()); ++k) groups += local.find(k) == k;
+    if (groups > 1) ++bad;
+  }
+  return bad;
+}
+
+int count_unreferenced_vertices(const Eigen::MatrixX3i& F, int num_vertices) {
+  std::vector<char> used(num_vertices, 0);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int i = 0; i < 3; ++i) used[F(f, i)] = 1;
+  return num_vertices - static_cast<int>(std::count(used.begin(), used.end(), 1));
+}
+
+int euler_characteristic(const Eigen::MatrixX3i& F, int num_vertices) {
+  const int used_vertices = num_vertices - count_unreferenced_vertices(F, num_vertices);
+  return used_vertices - build_edge_map(F).num_edges() + static_cast<int>(F.rows());
+}
+
+int genus(const Eigen::MatrixX3i& F, int num_vertices) {
+  Eigen::VectorXi component;
+  const int count = connected_components(F, num_vertices, &component);
+  std::vector<std::vector<int>> faces_of(count);
+  for (int f = 0; f < F.rows(); ++f) faces_of[component[f]].push_back(f);
+  int total = 0;
+  for (const auto& faces : faces_of) {
+    Eigen::MatrixX3i Fc(faces.size(), 3);
+    for (size_t k = 0; k < faces.size(); ++k) Fc.row(k) = F.row(faces[k]);
+    const int chi = euler_characteristic(Fc, num_vertices);
+    const int loops = static_cast<int>(boundary_loops(Fc).size());
+    total += (2 - chi - loops) / 2;
+  }
+  return total;
+}
+
+}  // namespace polycube

@@ -1,0 +1,379 @@
+#include "polycube/validate.h"
+
+#include "polycube/cgal_bridge.h"
+#include "polycube/errors.h"
+#include "polycube/mesh_topology.h"
+
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <queue>
+#include <set>
+#include <sstream>
+
+namespace polycube {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+namespace {
+
+// "1 face", "2 faces", "3 vertices".
+std::string plural(int n, const std::string& word) {
+  std::string form = word;
+  if (n != 1) {
+    const std::string vertex = "vertex";
+    if (form.size() >= vertex.size() && form.compare(form.size() - vertex.size(), vertex.size(), vertex) == 0)
+      form.replace(form.size() - 2, 2, "ices");
+    else
+      form += "s";
+  }
+  return std::to_string(n) + " " + form;
+}
+
+// Triangulates one polygon (indices into soup.points) and appends its triangles. Quads split
+// along the shorter diagonal; larger polygons use CGAL's minimal-area hole triangulation, which
+// stays valid for non-convex and non-planar polygons, with a fan as the last resort.
+void triangulate_polygon(const PolygonSoup& soup, const std::vector<int>& polygon,
+                         std::vector<std::array<int, 3>>& triangles) {
+  const int n = static_cast<int>(polygon.size());
+  if (n == 3) {
+    triangles.push_back({polygon[0], polygon[1], polygon[2]});
+    return;
+  }
+  auto point = [&](int k) -> const Eigen::Vector3d& { return soup.points[polygon[k]]; };
+  if (n == 4) {
+    if ((point(0) - point(2)).squaredNorm() <= (point(1) - point(3)).squaredNorm()) {
+      triangles.push_back({polygon[0], polygon[1], polygon[2]});
+      triangles.push_back({polygon[0], polygon[2], polygon[3]});
+    } else {
+      triangles.push_back({polygon[0], polygon[1], polygon[3]});
+      triangles.push_back({polygon[1], polygon[2], polygon[3]});
+    }
+    return;
+  }
+  std::vector<cgal::Point> polyline;
+  for (int k = 0; k < n; ++k) polyline.emplace_back(point(k).x(), point(k).y(), point(k).z());
+  std::vector<CGAL::Triple<int, int, int>> patch;
+  PMP::triangulate_hole_polyline(polyline, std::back_inserter(patch));
+  if (static_cast<int>(patch.size()) == n - 2) {
+    for (const auto& t : patch) triangles.push_back({polygon[t.first], polygon[t.second], polygon[t.third]});
+    return;
+  }
+  for (int k = 1; k + 1 < n; ++k) triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+}
+
+Eigen::MatrixX3i to_matrix(const std::vector<std::array<int, 3>>& triangles) {
+  Eigen::MatrixX3i F(triangles.size(), 3);
+  for (size_t f = 0; f < triangles.size(); ++f) F.row(f) << triangles[f][0], triangles[f][1], triangles[f][2];
+  return F;
+}
+
+// Keeps the rows of F marked in keep.
+Eigen::MatrixX3i select_faces(const Eigen::MatrixX3i& F, const std::vector<char>& keep) {
+  Eigen::MatrixX3i out(std::count(keep.begin(), keep.end(), 1), 3);
+  int row = 0;
+  for (int f = 0; f < F.rows(); ++f)
+    if (keep[f]) out.row(row++) = F.row(f);
+  return out;
+}
+
+// Drops vertices no face uses and renumbers the faces; returns how many were dropped.
+int remove_unreferenced_vertices(TriMesh& mesh) {
+  std::vector<int> new_index(mesh.num_vertices(), -1);
+  int count = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      int& slot = new_index[mesh.F(f, i)];
+      if (slot < 0) slot = count++;
+    }
+  const int removed = mesh.num_vertices() - count;
+  if (removed == 0) {
+    // Indices may still be permuted by first use; keep the input order when nothing is removed.
+    return 0;
+  }
+  // Keep the input order of the surviving vertices.
+  int next = 0;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (new_index[v] >= 0) new_index[v] = next++;
+  Eigen::MatrixX3d V(count, 3);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (new_index[v] >= 0) V.row(new_index[v]) = mesh.V.row(v);
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) mesh.F(f, i) = new_index[mesh.F(f, i)];
+  mesh.V = std::move(V);
+  return removed;
+}
+
+// Gives every face the orientation of its neighbours across manifold edges (breadth first from
+// the first face of each component). Returns the number of faces flipped; sets orientable to
+// false when a face would need both orientations.
+int orient_consistently(Eigen::MatrixX3i& F, bool& orientable) {
+  const EdgeMap map = build_edge_map(F);
+  const int nf = static_cast<int>(F.rows());
+  // Direction of edge e in face f: true when the face runs from E(e,0) to E(e,1).
+  auto runs_forward = [&](int f, int e) {
+    for (int i = 0; i < 3; ++i)
+      if (map.FE(f, i) == e) return F(f, i) == map.E(e, 0);
+    return false;
+  };
+  std::vector<int> flip(nf, -1);
+  orientable = true;
+  for (int seed = 0; seed < nf; ++seed) {
+    if (flip[seed] >= 0) continue;
+    flip[seed] = 0;
+    std::queue<int> queue;
+    queue.push(seed);
+    while (!queue.empty()) {
+      const int f = queue.front();
+      queue.pop();
+      for (int i = 0; i < 3; ++i) {
+        const int e = map.FE(f, i);
+        if (map.face_count[e] != 2) continue;
+        const int g = map.EF(e, 0) == f ? map.EF(e, 1) : map.EF(e, 0);
+        // Neighbours agree when they run the shared edge in opposite directions.
+        const bool same_direction = runs_forward(f, e) == runs_forward(g, e);
+        const int wanted = flip[f] ^ (same_direction ? 1 : 0);
+        if (flip[g] < 0) {
+          flip[g] = wanted;
+          queue.push(g);
+        } else if (flip[g] != wanted) {
+          orientable = false;
+        }
+      }
+    }
+  }
+  if (!orientable) return 0;
+  int flipped = 0;
+  for (int f = 0; f < nf; ++f)
+    if (flip[f] == 1) {
+      std::swap(F(f, 1), F(f, 2));
+      ++flipped;
+    }
+  return flipped;
+}
+
+// Flips every closed component whose enclosed volume is negative; returns faces flipped.
+int orient_outward(TriMesh& mesh) {
+  Eigen::VectorXi component;
+  const int count = connected_components(mesh.F, mesh.num_vertices(), &component);
+  std::vector<double> volume(count, 0.0);
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    volume[component[f]] += a.dot(b.cross(c));
+  }
+  int flipped = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    if (volume[component[f]] < 0) {
+      std::swap(mesh.F(f, 1), mesh.F(f, 2));
+      ++flipped;
+    }
+  return flipped;
+}
+
+int count_collinear_faces(const TriMesh& mesh) {
+  int count = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    auto p = [&](int i) { return cgal::Point(mesh.V(mesh.F(f, i), 0), mesh.V(mesh.F(f, i), 1), mesh.V(mesh.F(f, i), 2)); };
+    if (CGAL::collinear(p(0), p(1), p(2))) ++count;
+  }
+  return count;
+}
+
+// Closes every boundary loop of a manifold, oriented mesh; returns the number of loops filled.
+int fill_holes(TriMesh& mesh) {
+  cgal::SurfaceMesh sm = cgal::to_surface_mesh(mesh);
+  std::vector<cgal::SurfaceMesh::Halfedge_index> loops;
+  std::set<cgal::SurfaceMesh::Halfedge_index> seen;
+  for (auto h : sm.halfedges()) {
+    if (!sm.is_border(h) || seen.count(h)) continue;
+    loops.push_back(h);
+    for (auto g : CGAL::halfedges_around_face(h, sm)) seen.insert(g);
+  }
+  for (auto h : loops) {
+    std::vector<cgal::SurfaceMesh::Face_index> new_faces;
+    std::vector<cgal::SurfaceMesh::Vertex_index> new_vertices;
+    PMP::triangulate_and_refine_hole(sm, h, std::back_inserter(new_faces), std::back_inserter(new_vertices));
+  }
+  mesh = cgal::to_tri_mesh(sm);
+  return static_cast<int>(loops.size());
+}
+
+// Removes zero-area faces by CGAL's edge collapses and flips, on a copy; the copy replaces the
+// mesh only when it is still a manifold with the same boundary and no zero-area face is left.
+bool remove_degenerate_faces(TriMesh& mesh) {
+  try {
+    cgal::SurfaceMesh sm = cgal::to_surface_mesh(mesh);
+    if (!PMP::remove_degenerate_faces(sm)) return false;
+    TriMesh repaired = cgal::to_tri_mesh(sm);
+    const EdgeMap map = build_edge_map(repaired.F);
+    const EdgeMap before = build_edge_map(mesh.F);
+    const auto boundary = [](const EdgeMap& m) { return (m.face_count.array() == 1).count(); };
+    if ((map.face_count.array() > 2).any() || boundary(map) != boundary(before)) return false;
+    if (count_nonmanifold_vertices(repaired.F, repaired.num_vertices()) > 0) return false;
+    if (count_collinear_faces(repaired) > 0) return false;
+    mesh = std::move(repaired);
+    return true;
+  } catch (const std::exception&) {
+    return false;  // CGAL refused (e.g. a non-manifold configuration): leave the mesh as it was
+  }
+}
+
+}  // namespace
+
+PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options) {
+  PreparedMesh result;
+  MeshDiagnosis& d = result.diagnosis;
+  d.input_vertices = static_cast<int>(soup.points.size());
+  d.input_polygons = static_cast<int>(soup.polygons.size());
+
+  const int np = d.input_vertices;
+  for (int v = 0; v < np; ++v)
+    if (!soup.points[v].allFinite())
+      throw InputError("vertex " + std::to_string(v) + " has a non-finite coordinate");
+
+  // Triangulate; drop repeated corners inside a polygon first.
+  std::vector<std::array<int, 3>> triangles;
+  int polygons_split = 0, collapsed_polygons = 0;
+  for (size_t p = 0; p < soup.polygons.size(); ++p) {
+    std::vector<int> polygon;
+    for (int v : soup.polygons[p]) {
+      if (v < 0 || v >= np)
+        throw InputError("face " + std::to_string(p) + " refers to vertex " + std::to_string(v) + ", but there are " +
+                         std::to_string(np) + " vertices");
+      if (polygon.empty() || polygon.back() != v) polygon.push_back(v);
+    }
+    while (polygon.size() > 1 && polygon.front() == polygon.back()) polygon.pop_back();
+    std::vector<int> sorted = polygon;
+    std::sort(sorted.begin(), sorted.end());
+    if (polygon.size() < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+      ++collapsed_polygons;  // a repeated corner: the face covers no area as a polygon
+      continue;
+    }
+    if (polygon.size() > 3) ++polygons_split;
+    triangulate_polygon(soup, polygon, triangles);
+  }
+  if (polygons_split > 0)
+    result.repairs.push_back("triangulated " + plural(polygons_split, "polygon") + " with more than 3 corners");
+  if (collapsed_polygons > 0)
+    result.repairs.push_back("removed " + plural(collapsed_polygons, "face") + " with repeated corners");
+
+  // Drop exact duplicates (same corner set), keeping the first.
+  {
+    std::set<std::array<int, 3>> seen;
+    std::vector<std::array<int, 3>> unique;
+    for (const auto& t : triangles) {
+      std::array<int, 3> key = t;
+      std::sort(key.begin(), key.end());
+      if (seen.insert(key).second) unique.push_back(t);
+    }
+    const int duplicates = static_cast<int>(triangles.size() - unique.size());
+    if (duplicates > 0) result.repairs.push_back("removed " + plural(duplicates, "duplicate face"));
+    triangles = std::move(unique);
+  }
+
+  TriMesh& mesh = result.mesh;
+  mesh.V.resize(np, 3);
+  for (int v = 0; v < np; ++v) mesh.V.row(v) = soup.points[v].transpose();
+  mesh.F = to_matrix(triangles);
+  if (const int removed = remove_unreferenced_vertices(mesh); removed > 0)
+    result.repairs.push_back("removed " + plural(removed, "unreferenced vertex"));
+
+  if (mesh.num_faces() == 0) {
+    d.problems.push_back("no faces");
+    d.bbox = bounding_box(mesh.V);
+    d.vertices = mesh.num_vertices();
+    return result;
+  }
+
+  // Orientation across manifold edges.
+  EdgeMap map = build_edge_map(mesh.F);
+  d.nonmanifold_edges = static_cast<int>((map.face_count.array() > 2).count());
+  if (const int flipped = orient_consistently(mesh.F, d.orientable); flipped > 0)
+    result.repairs.push_back("flipped " + plural(flipped, "face") + " to orient the surface consistently");
+
+  if (options.largest_component) {
+    Eigen::VectorXi component;
+    const int count = connected_components(mesh.F, mesh.num_vertices(), &component);
+    if (count > 1) {
+      std::vector<int> size(count, 0);
+      for (int f = 0; f < mesh.num_faces(); ++f) ++size[component[f]];
+      const int largest = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+      std::vector<char> keep(mesh.num_faces());
+      for (int f = 0; f < mesh.num_faces(); ++f) keep[f] = component[f] == largest;
+      mesh.F = select_faces(mesh.F, keep);
+      remove_unreferenced_vertices(mesh);
+      result.repairs.push_back("kept the largest of " + plural(count, "component") + " (" +
+                               std::to_string(size[largest]) + " faces)");
+    }
+  }
+
+  const bool repairable = d.orientable && d.nonmanifold_edges == 0 &&
+                          count_nonmanifold_vertices(mesh.F, mesh.num_vertices()) == 0;
+  if (options.fill_holes && repairable) {
+    if (const int loops = static_cast<int>(boundary_loops(mesh.F).size()); loops > 0) {
+      fill_holes(mesh);
+      result.repairs.push_back("filled " + plural(loops, "hole"));
+    }
+  }
+
+  if (const int zero_area = count_collinear_faces(mesh); zero_area > 0) {
+    if (repairable && remove_degenerate_faces(mesh))
+      result.repairs.push_back("removed " + plural(zero_area, "zero-area face") + " by edge collapses and flips");
+  }
+
+  // Diagnose the result.
+  map = build_edge_map(mesh.F);
+  d.vertices = mesh.num_vertices();
+  d.faces = mesh.num_faces();
+  d.edges = map.num_edges();
+  d.nonmanifold_edges = static_cast<int>((map.face_count.array() > 2).count());
+  d.boundary_edges = static_cast<int>((map.face_count.array() == 1).count());
+  d.nonmanifold_vertices = count_nonmanifold_vertices(mesh.F, mesh.num_vertices());
+  d.components = connected_components(mesh.F, mesh.num_vertices());
+  d.boundary_loops = d.boundary_edges > 0 ? static_cast<int>(boundary_loops(mesh.F).size()) : 0;
+  d.degenerate_faces = count_collinear_faces(mesh);
+  d.euler = d.vertices - d.edges + d.faces;
+  d.bbox = bounding_box(mesh.V);
+
+  if (d.manifold() && d.orientable) {
+    d.genus = genus(mesh.F, mesh.num_vertices());
+    if (d.closed())
+      if (const int flipped = orient_outward(mesh); flipped > 0)
+        result.repairs.push_back("reversed the orientation of " + plural(flipped, "face") + " to face outward");
+    if (options.check_self_intersections) {
+      const cgal::SurfaceMesh sm = cgal::to_surface_mesh(mesh);
+      std::vector<std::pair<cgal::SurfaceMesh::Face_index, cgal::SurfaceMesh::Face_index>> pairs;
+      PMP::self_intersections(sm, std::back_inserter(pairs));
+      d.self_intersections = static_cast<int>(pairs.size());
+    }
+  }
+
+  if (d.nonmanifold_edges > 0)
+    d.problems.push_back(plural(d.nonmanifold_edges, "non-manifold edge") + " (more than two faces on an edge)");
+  if (d.nonmanifold_vertices > 0)
+    d.problems.push_back(plural(d.nonmanifold_vertices, "non-manifold vertex") + " (faces around it form several fans)");
+  if (!d.orientable) d.problems.push_back("not orientable (no consistent face orientation exists)");
+  if (d.boundary_edges > 0)
+    d.problems.push_back("open surface: " + plural(d.boundary_loops, "boundary loop") + " (" +
+                         plural(d.boundary_edges, "boundary edge") + "; --fill-holes closes them)");
+  if (d.components > 1)
+    d.problems.push_back(plural(d.components, "connected component") + " (--largest-component keeps the largest)");
+  if (d.degenerate_faces > 0) d.problems.push_back(plural(d.degenerate_faces, "zero-area face") + " that could not be removed");
+  if (d.self_intersections > 0)
+    d.warnings.push_back(plural(d.self_intersections, "pair") + " of self-intersecting faces (tolerated: the map is intrinsic)");
+  return result;
+}
+
+void require_mappable(const MeshDiagnosis& diagnosis) {
+  if (diagnosis.valid()) return;
+  std::ostringstream message;
+  message << "mesh is not mappable: ";
+  for (size_t i = 0; i < diagnosis.problems.size(); ++i) message << (i ? "; " : "") << diagnosis.problems[i];
+  throw MeshError(message.str());
+}
+
+}  // namespace polycube

@@ -1,0 +1,251 @@
+// prepare_mesh / require_mappable: the engine's entry gate, on real meshes and on fixtures built
+// here for each defect class.
+#include "polycube/validate.h"
+
+#include "formats/mesh_io.h"
+#include "polycube/errors.h"
+#include "polycube/mesh_topology.h"
+#include "support/generated_meshes.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+namespace polycube {
+namespace {
+
+// Genus of the closed meshes in tests/data (from the CGAL data documentation).
+const std::map<std::string, int> kClosedMeshes = {
+    {"sphere.off", 0}, {"torus_quad.off", 1}, {"rotor.off", 1},  {"elk.off", 1},
+    {"knot.off", 1},   {"joint.off", 2},      {"eight.off", 2},  {"double-torus-example.off", 2},
+    {"helmet.off", 3}, {"anchor.off", 4},     {"couplingdown.off", 9}};
+
+PolygonSoup soup_of(const std::vector<Eigen::Vector3d>& points, const std::vector<std::vector<int>>& polygons) {
+  return PolygonSoup{points, polygons};
+}
+
+// Unit cube as 6 quads, outward.
+PolygonSoup cube_quads() {
+  return soup_of({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
+                 {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}});
+}
+
+// Tetrahedron, outward, shifted by (dx, 0, 0).
+PolygonSoup tetrahedron(double dx = 0) {
+  return soup_of({{dx, 0, 0}, {dx + 1, 0, 0}, {dx, 1, 0}, {dx, 0, 1}}, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}});
+}
+
+PolygonSoup merge(PolygonSoup a, const PolygonSoup& b) {
+  const int offset = static_cast<int>(a.points.size());
+  a.points.insert(a.points.end(), b.points.begin(), b.points.end());
+  for (auto polygon : b.polygons) {
+    for (int& v : polygon) v += offset;
+    a.polygons.push_back(polygon);
+  }
+  return a;
+}
+
+TEST(Validate, GenusAndEulerOfEveryClosedTestMesh) {
+  for (const auto& [name, expected_genus] : kClosedMeshes) {
+    SCOPED_TRACE(name);
+    const PreparedMesh prepared = prepare_mesh(read_polygon_soup(test::data_path(name)));
+    const MeshDiagnosis& d = prepared.diagnosis;
+    EXPECT_TRUE(d.valid()) << (d.problems.empty() ? "" : d.problems.front());
+    ASSERT_TRUE(d.genus.has_value());
+    EXPECT_EQ(*d.genus, expected_genus);
+    EXPECT_EQ(d.euler, 2 - 2 * expected_genus);
+    EXPECT_EQ(d.components, 1);
+    EXPECT_EQ(d.boundary_loops, 0);
+    EXPECT_GT(signed_volume(prepared.mesh), 0) << "prepared meshes face outward";
+    EXPECT_GE(d.self_intersections, 0) << "checked on manifold meshes";
+  }
+}
+
+PolygonSoup soup_of(const TriMesh& mesh) {
+  PolygonSoup soup;
+  for (int v = 0; v < mesh.num_vertices(); ++v) soup.points.push_back(mesh.V.row(v).transpose());
+  for (int f = 0; f < mesh.num_faces(); ++f) soup.polygons.push_back({mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2)});
+  return soup;
+}
+
+TEST(Validate, GenusOfGeneratedSurfaces) {
+  for (int g = 0; g <= 3; ++g) {
+    SCOPED_TRACE(g);
+    const PreparedMesh prepared = prepare_mesh(soup_of(test::make_genus_surface(g, 32)));
+    EXPECT_TRUE(prepared.diagnosis.valid());
+    EXPECT_EQ(prepared.diagnosis.genus, g);
+    EXPECT_EQ(prepared.diagnosis.euler, 2 - 2 * g);
+  }
+  const PreparedMesh torus = prepare_mesh(soup_of(test::make_torus(2.0, 0.5, 24, 12)));
+  EXPECT_TRUE(torus.diagnosis.valid());
+  EXPECT_EQ(torus.diagnosis.genus, 1);
+}
+
+TEST(Validate, GeneratedFixturesCarryTheirDefect) {
+  EXPECT_EQ(prepare_mesh(soup_of(test::open_cylinder())).diagnosis.boundary_loops, 2);
+  EXPECT_EQ(prepare_mesh(soup_of(test::two_tetrahedra())).diagnosis.components, 2);
+  EXPECT_GT(prepare_mesh(soup_of(test::nonmanifold_edge())).diagnosis.nonmanifold_edges, 0);
+  EXPECT_EQ(prepare_mesh(soup_of(test::nonmanifold_vertex())).diagnosis.nonmanifold_vertices, 1);
+  const PreparedMesh flipped = prepare_mesh(soup_of(test::flipped_face_tetrahedron()));
+  EXPECT_TRUE(flipped.diagnosis.valid());
+  EXPECT_GT(signed_volume(flipped.mesh), 0);
+}
+
+TEST(Validate, QuadCubeIsTriangulatedAndValid) {
+  const PreparedMesh prepared = prepare_mesh(cube_quads());
+  EXPECT_EQ(prepared.mesh.num_faces(), 12);
+  EXPECT_TRUE(prepared.diagnosis.valid());
+  EXPECT_EQ(prepared.diagnosis.genus, 0);
+  EXPECT_NEAR(signed_volume(prepared.mesh), 1.0, 1e-12);
+  EXPECT_NEAR(surface_area(prepared.mesh), 6.0, 1e-12);
+}
+
+TEST(Validate, NonConvexPolygonIsTriangulatedWithoutOverlap) {
+  // An L-shaped prism: the two L faces are non-convex hexagons, where a fan would overlap.
+  std::vector<Eigen::Vector3d> points;
+  const double L[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  for (int z = 0; z < 2; ++z)
+    for (const auto& p : L) points.emplace_back(p[0], p[1], z);
+  std::vector<std::vector<int>> polygons = {{5, 4, 3, 2, 1, 0}, {6, 7, 8, 9, 10, 11}};
+  for (int i = 0; i < 6; ++i) polygons.push_back({i, (i + 1) % 6, 6 + (i + 1) % 6, 6 + i});
+  const PreparedMesh prepared = prepare_mesh(soup_of(points, polygons));
+  EXPECT_TRUE(prepared.diagnosis.valid());
+  EXPECT_NEAR(signed_volume(prepared.mesh), 3.0, 1e-12);
+  EXPECT_NEAR(surface_area(prepared.mesh), 2 * 3.0 + 8.0, 1e-12);
+}
+
+TEST(Validate, InconsistentAndInwardOrientationIsRepaired) {
+  PolygonSoup soup = tetrahedron();
+  std::swap(soup.polygons[1][0], soup.polygons[1][1]);  // one face flipped
+  PreparedMesh prepared = prepare_mesh(soup);
+  EXPECT_TRUE(prepared.diagnosis.valid());
+  EXPECT_FALSE(prepared.repairs.empty());
+  EXPECT_GT(signed_volume(prepared.mesh), 0);
+
+  PolygonSoup inward = tetrahedron();
+  for (auto& polygon : inward.polygons) std::swap(polygon[0], polygon[1]);
+  prepared = prepare_mesh(inward);
+  EXPECT_TRUE(prepared.diagnosis.valid());
+  EXPECT_GT(signed_volume(prepared.mesh), 0);
+}
+
+TEST(Validate, RepeatedCornerDuplicateFacesAndUnreferencedVerticesAreRemoved) {
+  PolygonSoup soup = tetrahedron();
+  soup.polygons.push_back({0, 0, 1});         // repeated corner
+  soup.polygons.push_back(soup.polygons[0]);  // duplicate
+  soup.points.emplace_back(5, 5, 5);          // unreferenced
+  const PreparedMesh prepared = prepare_mesh(soup);
+  EXPECT_TRUE(prepared.diagnosis.valid());
+  EXPECT_EQ(prepared.mesh.num_faces(), 4);
+  EXPECT_EQ(prepared.mesh.num_vertices(), 4);
+  EXPECT_EQ(prepared.repairs.size(), 3u);
+}
+
+TEST(Validate, OpenSurfaceReportsLoopsAndFillHolesClosesIt) {
+  PolygonSoup open = cube_quads();
+  open.polygons.pop_back();
+  open.polygons.erase(open.polygons.begin());  // bottom and one side removed: one loop
+  PreparedMesh prepared = prepare_mesh(open);
+  EXPECT_FALSE(prepared.diagnosis.valid());
+  EXPECT_EQ(prepared.diagnosis.boundary_loops, 1);
+  EXPECT_EQ(prepared.diagnosis.boundary_edges, 6);
+  EXPECT_EQ(prepared.diagnosis.genus, 0);
+  EXPECT_THROW(require_mappable(prepared.diagnosis), MeshError);
+
+  PrepareOptions fill;
+  fill.fill_holes = true;
+  prepared = prepare_mesh(open, fill);
+  EXPECT_TRUE(prepared.diagnosis.valid()) << prepared.diagnosis.problems.front();
+  EXPECT_EQ(prepared.diagnosis.genus, 0);
+  EXPECT_GT(signed_volume(prepared.mesh), 0.5);
+}
+
+TEST(Validate, SeveralComponentsAndLargestComponent) {
+  PolygonSoup two = merge(merge(cube_quads(), tetrahedron(3)), tetrahedron(6));
+  PreparedMesh prepared = prepare_mesh(two);
+  EXPECT_EQ(prepared.diagnosis.components, 3);
+  EXPECT_FALSE(prepared.diagnosis.valid());
+  try {
+    require_mappable(prepared.diagnosis);
+    FAIL() << "expected MeshError";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("3 connected components"), std::string::npos) << e.what();
+  }
+  PrepareOptions largest;
+  largest.largest_component = true;
+  prepared = prepare_mesh(two, largest);
+  EXPECT_TRUE(prepared.diagnosis.valid());
+  EXPECT_EQ(prepared.mesh.num_faces(), 12);  // the cube
+}
+
+TEST(Validate, NonManifoldEdgeAndVertex) {
+  // Three triangles on one edge.
+  PolygonSoup fin = soup_of({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}}, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
+  PreparedMesh prepared = prepare_mesh(fin);
+  EXPECT_EQ(prepared.diagnosis.nonmanifold_edges, 1);
+  EXPECT_FALSE(prepared.diagnosis.genus.has_value());
+  EXPECT_FALSE(prepared.diagnosis.valid());
+
+  // Two tetrahedra sharing one vertex (the apex of the second is vertex 0 of the first).
+  PolygonSoup bowtie = tetrahedron();
+  bowtie.points.push_back({-1, 0, 0});
+  bowtie.points.push_back({0, -1, 0});
+  bowtie.points.push_back({0, 0, -1});
+  for (const auto& face : std::vector<std::vector<int>>{{0, 4, 5}, {0, 5, 6}, {0, 6, 4}, {4, 6, 5}})
+    bowtie.polygons.push_back(face);
+  prepared = prepare_mesh(bowtie);
+  EXPECT_EQ(prepared.diagnosis.nonmanifold_vertices, 1);
+  EXPECT_EQ(prepared.diagnosis.nonmanifold_edges, 0);
+  EXPECT_FALSE(prepared.diagnosis.valid());
+}
+
+TEST(Validate, SelfIntersectionsAreCountedAndOnlyWarned) {
+  // Two overlapping closed tetrahedra: each is valid alone, together they intersect.
+  PreparedMesh prepared = prepare_mesh(merge(tetrahedron(0), tetrahedron(0.25)));
+  EXPECT_GT(prepared.diagnosis.self_intersections, 0);
+  EXPECT_EQ(prepared.diagnosis.warnings.size(), 1u);
+  EXPECT_EQ(prepared.diagnosis.problems.size(), 1u) << "only the two components are a problem";
+
+  PrepareOptions skip;
+  skip.check_self_intersections = false;
+  prepared = prepare_mesh(tetrahedron(), skip);
+  EXPECT_EQ(prepared.diagnosis.self_intersections, -1);
+  EXPECT_TRUE(prepared.diagnosis.valid());
+}
+
+TEST(Validate, ZeroAreaFaceIsRemovedWhenTheMeshStaysValid) {
+  // A cube whose top edge 4-5 carries an extra vertex 8 at its middle: the top is triangulated
+  // through 8, the front keeps the long edge 4-5, and a zero-area "cap" triangle 4-5-8 closes
+  // the gap between them. The mesh is closed and manifold but has one collinear face.
+  PolygonSoup soup = cube_quads();
+  soup.points.push_back({0.5, 0, 1});
+  soup.polygons[1] = {4, 8, 7};
+  soup.polygons.push_back({8, 5, 6});
+  soup.polygons.push_back({8, 6, 7});
+  soup.polygons.push_back({4, 5, 8});
+  const PreparedMesh prepared = prepare_mesh(soup);
+  EXPECT_TRUE(prepared.diagnosis.valid()) << (prepared.diagnosis.problems.empty() ? "" : prepared.diagnosis.problems[0]);
+  EXPECT_EQ(prepared.diagnosis.degenerate_faces, 0);
+  EXPECT_FALSE(prepared.repairs.empty());
+  EXPECT_NEAR(signed_volume(prepared.mesh), 1.0, 1e-12);
+  EXPECT_NEAR(surface_area(prepared.mesh), 6.0, 1e-12);
+}
+
+TEST(Validate, NonFiniteCoordinatesAndBadIndicesThrowInputError) {
+  PolygonSoup nan = tetrahedron();
+  nan.points[2].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(prepare_mesh(nan), InputError);
+  PolygonSoup bad_index = tetrahedron();
+  bad_index.polygons[0][1] = 17;
+  EXPECT_THROW(prepare_mesh(bad_index), InputError);
+}
+
+TEST(Validate, EmptySoupIsNotMappable) {
+  const PreparedMesh prepared = prepare_mesh(PolygonSoup{});
+  EXPECT_FALSE(prepared.diagnosis.valid());
+  EXPECT_THROW(require_mappable(prepared.diagnosis), MeshError);
+}
+
+}  // namespace
+}  // namespace polycube

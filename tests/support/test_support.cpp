@@ -1,0 +1,51 @@
+#include "support/test_support.h"
+
+#include <sys/wait.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace polycube::test {
+
+std::string data_path(const std::string& name) { return std::string(POLYCUBE_TEST_DATA_DIR) + "/" + name; }
+
+std::string example_path(const std::string& name) { return std::string(POLYCUBE_EXAMPLES_DIR) + "/" + name; }
+
+std::string binary_path() { return POLYCUBE_BINARY; }
+
+std::string temp_dir(const std::string& tag) {
+  static std::atomic<int> counter{0};
+  std::random_device rd;
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("polycube-test-" + tag + "-" + std::to_string(rd()) + "-" + std::to_string(counter++));
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+namespace {
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+}  // namespace
+
+int run_command(const std::string& command, std::string* out, std::string* err) {
+  const std::string dir = temp_dir("cmd");
+  const std::string out_path = dir + "/stdout", err_path = dir + "/stderr";
+  const std::string full = command + " > '" + out_path + "' 2> '" + err_path + "' < /dev/null";
+  const int status = std::system(full.c_str());
+  if (out) *out = slurp(out_path);
+  if (err) *err = slurp(err_path);
+  std::filesystem::remove_all(dir);
+  if (status == -1) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+}  // namespace polycube::test
