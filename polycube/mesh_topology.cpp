@@ -1,25 +1,11 @@
 #include "polycube/mesh_topology.h"
 
+#include "polycube/disjoint_sets.h"
+
 #include <algorithm>
-#include <numeric>
 #include <unordered_map>
 
 namespace polycube {
-
-namespace {
-
-// Union-find with path halving.
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
-};
-
-}  // namespace
 
 EdgeMap build_edge_map(const Eigen::MatrixX3i& F) {
   const int nf = static_cast<int>(F.rows());

@@ -15,12 +15,6 @@
 namespace polycube {
 namespace {
 
-// Genus of the closed meshes in tests/data (from the CGAL data documentation).
-const std::map<std::string, int> kClosedMeshes = {
-    {"sphere.off", 0}, {"torus_quad.off", 1}, {"rotor.off", 1},  {"elk.off", 1},
-    {"knot.off", 1},   {"joint.off", 2},      {"eight.off", 2},  {"double-torus-example.off", 2},
-    {"helmet.off", 3}, {"anchor.off", 4},     {"couplingdown.off", 9}};
-
 PolygonSoup soup_of(const std::vector<Eigen::Vector3d>& points, const std::vector<std::vector<int>>& polygons) {
   return PolygonSoup{points, polygons};
 }
@@ -47,7 +41,7 @@ PolygonSoup merge(PolygonSoup a, const PolygonSoup& b) {
 }
 
 TEST(Validate, GenusAndEulerOfEveryClosedTestMesh) {
-  for (const auto& [name, expected_genus] : kClosedMeshes) {
+  for (const auto& [name, expected_genus] : test::closed_test_meshes()) {
     SCOPED_TRACE(name);
     const PreparedMesh prepared = prepare_mesh(read_polygon_soup(test::data_path(name)));
     const MeshDiagnosis& d = prepared.diagnosis;

@@ -27,7 +27,7 @@ TriMesh make_torus(double R, double r, int nu, int nv);
 //               count grows with resolution^2: about 5k-12k triangles at 24, 20k-50k at 48
 //               (fewest for long shapes such as genus 3, most for genus 1)
 // Measured quality for genus 0..10, resolution 16..96: smallest angle > 10 degrees (> 13 up to
-// resolution 48), smallest / mean triangle area > 0.01.
+// resolution 48), smallest / mean triangle area > 0.005.
 // Deterministic: the same arguments give the same mesh. Throws std::invalid_argument on bad
 // parameters.
 TriMesh make_genus_surface(int genus, int resolution = 48);

@@ -1,7 +1,11 @@
 #include "support/test_support.h"
 
+#include "formats/mesh_io.h"
+#include "polycube/validate.h"
+
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +17,22 @@
 namespace polycube::test {
 
 std::string data_path(const std::string& name) { return std::string(POLYCUBE_TEST_DATA_DIR) + "/" + name; }
+
+const std::map<std::string, int>& closed_test_meshes() {
+  static const std::map<std::string, int> meshes = {
+      {"sphere.off", 0}, {"torus_quad.off", 1}, {"rotor.off", 1},  {"elk.off", 1},
+      {"knot.off", 1},   {"joint.off", 2},      {"eight.off", 2},  {"double-torus-example.off", 2},
+      {"helmet.off", 3}, {"anchor.off", 4},     {"couplingdown.off", 9}};
+  return meshes;
+}
+
+TriMesh load_test_mesh(const std::string& name) {
+  PrepareOptions options;
+  options.check_self_intersections = false;
+  PreparedMesh prepared = prepare_mesh(read_polygon_soup(data_path(name)), options);
+  require_mappable(prepared.diagnosis);
+  return std::move(prepared.mesh);
+}
 
 std::string example_path(const std::string& name) { return std::string(POLYCUBE_EXAMPLES_DIR) + "/" + name; }
 
@@ -47,5 +67,15 @@ int run_command(const std::string& command, std::string* out, std::string* err) 
   if (status == -1) return -1;
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
+
+std::string quoted(const std::string& s) { return "'" + s + "'"; }
+
+CliRun polycube_cli(const std::string& arguments) {
+  CliRun run;
+  run.code = run_command(quoted(binary_path()) + " " + arguments, &run.out, &run.err);
+  return run;
+}
+
+int line_count(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
 
 }  // namespace polycube::test

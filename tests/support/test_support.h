@@ -4,6 +4,7 @@
 
 #include "polycube/mesh.h"
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,13 @@ namespace polycube::test {
 
 // Absolute path of a file in tests/data/.
 std::string data_path(const std::string& name);
+
+// The closed meshes in tests/data with their genus (from the CGAL data documentation).
+const std::map<std::string, int>& closed_test_meshes();
+
+// A mesh of tests/data read and prepared (polygons triangulated, oriented outward), without the
+// self-intersection search. Throws MeshError if it is not mappable.
+TriMesh load_test_mesh(const std::string& name);
 
 // Absolute path of a file in examples/.
 std::string example_path(const std::string& name);
@@ -23,5 +31,20 @@ std::string temp_dir(const std::string& tag);
 
 // Runs a shell command; returns its exit code and fills stdout/stderr when given.
 int run_command(const std::string& command, std::string* out = nullptr, std::string* err = nullptr);
+
+// A run of the built `polycube` binary.
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs `polycube <arguments>` (arguments are passed to the shell as written).
+CliRun polycube_cli(const std::string& arguments);
+
+// s in single quotes for the shell.
+std::string quoted(const std::string& s);
+
+// Number of newline characters in text.
+int line_count(const std::string& text);
 
 }  // namespace polycube::test
