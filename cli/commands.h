@@ -42,6 +42,7 @@ class Progress {
 // The callback returns the exit code; exceptions are mapped to exit codes by run().
 using CommandRunner = std::function<int()>;
 void add_inspect_command(CLI::App& app, const GlobalOptions& global, CommandRunner& runner);
+void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& runner);
 
 // Parses argv, runs the chosen subcommand, prints one-line errors, returns the exit code.
 int run(int argc, char** argv);

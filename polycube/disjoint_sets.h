@@ -8,7 +8,13 @@ namespace polycube {
 
 class DisjointSets {
  public:
-  explicit DisjointSets(int n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  explicit DisjointSets(int n = 0) { reset(n); }
+
+  // n singletons again.
+  void reset(int n) {
+    parent_.resize(n);
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
 
   // Representative of x's set.
   int find(int x) {
@@ -16,7 +22,8 @@ class DisjointSets {
     return x;
   }
 
-  // Merges the sets of a and b; returns false when they were already one set.
+  // Merges the sets of a and b, b's representative staying the representative; returns false
+  // when they were already one set.
   bool unite(int a, int b) {
     a = find(a);
     b = find(b);

@@ -4,34 +4,20 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <algorithm>
 #include <filesystem>
+#include <algorithm>
 #include <map>
 
 namespace polycube {
 namespace {
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
-
-struct CliRun {
-  int code;
-  std::string out, err;
-};
-
-CliRun polycube_cli(const std::string& arguments) {
-  CliRun run;
-  run.code = test::run_command(quoted(test::binary_path()) + " " + arguments, &run.out, &run.err);
-  return run;
-}
-
-int line_count(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
+using test::CliRun;
+using test::line_count;
+using test::polycube_cli;
+using test::quoted;
 
 TEST(InspectCli, JsonGenusOnEveryClosedTestMesh) {
-  const std::map<std::string, int> closed = {
-      {"sphere.off", 0}, {"torus_quad.off", 1}, {"rotor.off", 1},  {"elk.off", 1},
-      {"knot.off", 1},   {"joint.off", 2},      {"eight.off", 2},  {"double-torus-example.off", 2},
-      {"helmet.off", 3}, {"anchor.off", 4},     {"couplingdown.off", 9}};
-  for (const auto& [name, genus] : closed) {
+  for (const auto& [name, genus] : test::closed_test_meshes()) {
     SCOPED_TRACE(name);
     const CliRun run = polycube_cli("inspect --json --quiet " + quoted(test::data_path(name)));
     EXPECT_EQ(run.code, 0) << run.err;
@@ -96,6 +82,36 @@ TEST(InspectCli, RepairFlagsMakeBadInputsMappable) {
                      quoted(test::data_path("bad/many-components-bones.off")));
   EXPECT_EQ(run.code, 0) << run.err;
   EXPECT_EQ(nlohmann::json::parse(run.out).at("components").get<int>(), 1);
+}
+
+TEST(InspectCli, TopologyReportsCriticalPointsPlanesAndGenusZeroPieces) {
+  const std::map<std::string, int> meshes = {{"sphere.off", 0}, {"rotor.off", 1}, {"eight.off", 2}, {"anchor.off", 4}};
+  for (const auto& [name, genus] : meshes) {
+    SCOPED_TRACE(name);
+    const CliRun run = polycube_cli("inspect --json --quiet --topology " + quoted(test::data_path(name)));
+    ASSERT_EQ(run.code, 0) << run.err;
+    const auto j = nlohmann::json::parse(run.out);
+    EXPECT_EQ(j.at("critical_points").at("minima").get<int>(), 1);
+    EXPECT_EQ(j.at("critical_points").at("maxima").get<int>(), 1);
+    EXPECT_EQ(j.at("critical_points").at("saddles").get<int>(), 2 * genus);
+    const auto& planes = j.at("cutting_planes");
+    EXPECT_FALSE(planes.empty());
+    EXPECT_TRUE(std::is_sorted(planes.begin(), planes.end()));
+    const double zmin = j.at("bounding_box").at("min")[2], zmax = j.at("bounding_box").at("max")[2];
+    for (const auto& z : planes) {
+      EXPECT_GT(z.get<double>(), zmin) << "planes are in the input's coordinates";
+      EXPECT_LT(z.get<double>(), zmax);
+    }
+    int euler_sum = 0;
+    for (const auto& piece : j.at("pieces")) {
+      EXPECT_EQ(piece.at("genus").get<int>(), 0);
+      EXPECT_GE(piece.at("boundaries").get<int>(), 1);
+      euler_sum += piece.at("euler").get<int>();
+      const int below = piece.at("plane_below"), above = piece.at("plane_above");
+      EXPECT_TRUE(below == -1 || above == -1 || above == below + 1) << "a piece lies between adjacent planes";
+    }
+    EXPECT_EQ(euler_sum, 2 - 2 * genus);
+  }
 }
 
 TEST(InspectCli, UsageAndMissingFileErrors) {

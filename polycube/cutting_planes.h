@@ -1,0 +1,52 @@
+// The horizontal cutting planes of §3.2: one between every two consecutive levels of critical
+// points, and more wherever two planes are farther apart than d_z.
+#pragma once
+
+#include "polycube/critical_points.h"
+#include "polycube/mesh.h"
+
+#include <vector>
+
+namespace polycube {
+
+struct CuttingPlaneOptions {
+  // Largest distance between adjacent planes, in the units of the model scaled to the unit cube
+  // (largest bounding-box side 1). §3.2's d_z.
+  double dz = 0.08;
+  // Critical points whose heights differ by at most this fraction of the model height belong to
+  // one level (§3.2 uses 0.01).
+  double level_merge = 0.01;
+  // Also keep the gaps between the lowest (highest) vertex and the first (last) plane below dz.
+  // §3.2 only subdivides between planes; true gives the end caps the same resolution.
+  bool split_end_gaps = true;
+};
+
+// Planes in input coordinates and in normalised height (z - z_min) / (largest bounding-box side).
+//   z, z_normalised   ascending, strictly inside the z range of the mesh
+//   levels            distinct levels of critical points (including the lowest and highest vertex)
+//   level_planes      planes between consecutive levels (levels - 1)
+//   spacing_planes    planes added so that no gap exceeds dz
+struct CuttingPlanes {
+  std::vector<double> z;
+  std::vector<double> z_normalised;
+  int levels = 0;
+  int level_planes = 0;
+  int spacing_planes = 0;
+};
+
+// Sorts the critical points (minima, saddles, maxima) and the lowest and highest vertex by z and
+// merges them into levels: sorted heights closer than level_merge * height join one level.
+// Between consecutive levels goes one plane, at the middle of the gap between the top of the
+// lower level and the bottom of the upper one (§3.2 takes the midpoint of representative
+// points; the gap keeps the plane clear of every critical point). Gaps wider than dz get
+// floor(gap / dz) more planes, evenly spaced (§3.2). Each plane is then moved a little (within a
+// quarter of its spacing, and for spacing planes within half the slack dz - spacing, so that no
+// gap exceeds dz) to the height farthest from any vertex (place_plane), so no vertex lies on a
+// plane.
+//   mesh      the mesh whose vertices the critical points index
+//   critical  critical points of the harmonic function
+// Throws std::invalid_argument for non-positive dz or negative level_merge, MeshError for a mesh
+// with no height.
+CuttingPlanes cutting_planes(const TriMesh& mesh, const CriticalPoints& critical, const CuttingPlaneOptions& options = {});
+
+}  // namespace polycube

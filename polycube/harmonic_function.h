@@ -1,0 +1,60 @@
+// The harmonic function of §3.1 (eq. 1): Δf = 0 on the surface with f = 0 at the bottom-most and
+// f = 1 at the top-most vertex. Its critical points reveal the topology (handles) of the mesh.
+#pragma once
+
+#include "polycube/intrinsic_delaunay.h"
+#include "polycube/mesh.h"
+
+#include <Eigen/Core>
+
+namespace polycube {
+
+struct HarmonicOptions {
+  // Build the Laplacian on the intrinsic Delaunay triangulation (all cotangent weights >= 0, so
+  // f obeys the discrete maximum principle). false: the input triangulation, whose obtuse
+  // triangles can give negative weights and spurious extrema.
+  bool intrinsic_delaunay = true;
+  // Steps of iterative refinement after the Cholesky solve (each one a residual and two
+  // triangular solves); they bring f to nearly full double precision where it is flat.
+  int refinement_steps = 2;
+  // With intrinsic Delaunay: edge weights below this fraction of the mean edge weight are
+  // raised to it (see HarmonicFunction::raised_weights).
+  double min_weight = 1e-6;
+};
+
+// f and what it was computed on.
+//   f          #V values in [0,1]; f(source) = 0, f(sink) = 1
+//   source     lowest vertex by z (smallest index among equal z)
+//   sink       highest vertex by z (smallest index among equal z)
+//   intrinsic  the triangulation the Laplacian was built on (the input's own triangulation with
+//              Euclidean lengths when options.intrinsic_delaunay is false); critical points of f
+//              are taken on its vertex links
+//   negative_weights  edges whose cotangent weight is below -1e-10 times the mean: only edges
+//              the flips could not make Delaunay (IntrinsicTriangulation::non_delaunay_edges),
+//              or with intrinsic_delaunay off any edge opposite two angles summing to over π
+//   raised_weights    with intrinsic Delaunay: edges whose weight was below min_weight times the
+//              mean weight (zero for cocircular quads, negative as above) and was raised to it,
+//              so that all weights are positive and f obeys the strict maximum principle: every
+//              free vertex lies strictly between its lowest and highest neighbour
+//   residual   max-norm of the Laplace equation's residual at the free vertices, relative to
+//              the right-hand side
+struct HarmonicFunction {
+  Eigen::VectorXd f;
+  int source = -1;
+  int sink = -1;
+  IntrinsicTriangulation intrinsic;
+  int intrinsic_flips = 0;
+  int negative_weights = 0;
+  int raised_weights = 0;
+  double residual = 0;
+};
+
+// Solves the Dirichlet problem of eq. (1) with the cotangent Laplacian (sparse LDLT, Eigen).
+// Lengths are taken after scaling the model to the unit cube (largest bounding-box side 1), so
+// f does not depend on the scale or position of the input.
+//   mesh  closed, connected, edge-manifold, consistently oriented mesh; every vertex used
+// Throws MeshError if the mesh is not of that kind or has no height (all z equal), and
+// AlgorithmError if the factorisation fails.
+HarmonicFunction harmonic_function(const TriMesh& mesh, const HarmonicOptions& options = {});
+
+}  // namespace polycube

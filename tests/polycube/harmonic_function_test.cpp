@@ -1,0 +1,124 @@
+// harmonic_function (§3.1, eq. 1): boundary values, the discrete maximum principle, the Laplace
+// residual, and independence of scale and position.
+#include "polycube/harmonic_function.h"
+
+#include "formats/mesh_io.h"
+#include "polycube/errors.h"
+#include "polycube/validate.h"
+#include "support/generated_meshes.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace polycube {
+namespace {
+
+const std::vector<std::string> kMeshes = {"sphere.off", "rotor.off",  "elk.off",    "knot.off",
+                                          "joint.off",  "eight.off",  "helmet.off", "anchor.off",
+                                          "couplingdown.off"};
+
+// Lowest and highest neighbour value of every vertex in the triangulation f was solved on.
+void neighbour_range(const IntrinsicTriangulation& T, const Eigen::VectorXd& f, std::vector<double>& low,
+                     std::vector<double>& high) {
+  low.assign(f.size(), std::numeric_limits<double>::infinity());
+  high.assign(f.size(), -std::numeric_limits<double>::infinity());
+  for (int k = 0; k < T.F.rows(); ++k)
+    for (int i = 0; i < 3; ++i) {
+      const int a = T.F(k, i), b = T.F(k, (i + 1) % 3);
+      low[a] = std::min(low[a], f[b]);
+      high[a] = std::max(high[a], f[b]);
+      low[b] = std::min(low[b], f[a]);
+      high[b] = std::max(high[b], f[a]);
+    }
+}
+
+void expect_harmonic(const TriMesh& mesh, const HarmonicFunction& h) {
+  ASSERT_EQ(h.f.size(), mesh.num_vertices());
+  // Boundary conditions at the lowest and highest vertex (smallest index among equal z).
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    EXPECT_TRUE(mesh.V(v, 2) > mesh.V(h.source, 2) || (mesh.V(v, 2) == mesh.V(h.source, 2) && v >= h.source));
+    EXPECT_TRUE(mesh.V(v, 2) < mesh.V(h.sink, 2) || (mesh.V(v, 2) == mesh.V(h.sink, 2) && v >= h.sink));
+  }
+  EXPECT_EQ(h.f[h.source], 0.0);
+  EXPECT_EQ(h.f[h.sink], 1.0);
+  EXPECT_LT(h.residual, 1e-10);
+  // Maximum principle: every free vertex lies within its neighbours' range (no interior
+  // extrema); with all weights positive even strictly inside it, up to rounding.
+  std::vector<double> low, high;
+  neighbour_range(h.intrinsic, h.f, low, high);
+  int violations = 0;
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    if (v == h.source || v == h.sink) continue;
+    violations += !(h.f[v] >= low[v] - 1e-13 && h.f[v] <= high[v] + 1e-13);
+  }
+  EXPECT_EQ(violations, 0);
+  EXPECT_GE(h.f.minCoeff(), 0.0);
+  EXPECT_LE(h.f.maxCoeff(), 1.0);
+}
+
+TEST(HarmonicFunction, BoundaryValuesMaximumPrincipleAndResidualOnTestMeshes) {
+  for (const auto& name : kMeshes) {
+    SCOPED_TRACE(name);
+    const TriMesh mesh = test::load_test_mesh(name);
+    const HarmonicFunction h = harmonic_function(mesh);
+    expect_harmonic(mesh, h);
+    EXPECT_EQ(h.negative_weights, h.intrinsic.non_delaunay_edges);
+  }
+}
+
+TEST(HarmonicFunction, GeneratedSurfaces) {
+  for (int g = 0; g <= 4; ++g) {
+    SCOPED_TRACE("genus " + std::to_string(g));
+    const TriMesh mesh = test::make_genus_surface(g, 32);
+    expect_harmonic(mesh, harmonic_function(mesh));
+  }
+  // Cocircular quads everywhere: zero weights raised, nothing negative.
+  const TriMesh torus = test::make_torus(2.0, 0.7, 24, 12);
+  const HarmonicFunction h = harmonic_function(torus);
+  expect_harmonic(torus, h);
+  EXPECT_EQ(h.negative_weights, 0);
+}
+
+TEST(HarmonicFunction, IntrinsicDelaunayRemovesNegativeWeights) {
+  // The CAD part has obtuse triangles: its own cotangent weights go negative.
+  const TriMesh mesh = test::load_test_mesh("couplingdown.off");
+  HarmonicOptions plain;
+  plain.intrinsic_delaunay = false;
+  EXPECT_GT(harmonic_function(mesh, plain).negative_weights, 0);
+  const HarmonicFunction h = harmonic_function(mesh);
+  EXPECT_EQ(h.negative_weights, 0);
+  EXPECT_GT(h.intrinsic_flips, 0);
+}
+
+TEST(HarmonicFunction, UnchangedUnderScalingAndTranslation) {
+  const TriMesh mesh = test::load_test_mesh("helmet.off");
+  const HarmonicFunction reference = harmonic_function(mesh);
+  for (double scale : {1e-6, 1e6}) {
+    for (double shift : {0.0, 1000.0}) {
+      TriMesh moved = mesh;
+      moved.V = (mesh.V * scale).rowwise() + Eigen::RowVector3d(shift, -2 * shift, 3 * shift) * scale;
+      const HarmonicFunction h = harmonic_function(moved);
+      EXPECT_EQ(h.source, reference.source);
+      EXPECT_EQ(h.sink, reference.sink);
+      EXPECT_EQ(h.intrinsic_flips, reference.intrinsic_flips);
+      EXPECT_LT((h.f - reference.f).cwiseAbs().maxCoeff(), 1e-9) << "scale " << scale << " shift " << shift;
+    }
+  }
+}
+
+TEST(HarmonicFunction, RejectsMeshesItCannotSolveOn) {
+  EXPECT_THROW(harmonic_function(test::two_tetrahedra()), MeshError);
+  EXPECT_THROW(harmonic_function(test::open_cylinder()), MeshError);
+  TriMesh unused = test::make_sphere(1);
+  unused.V.conservativeResize(unused.V.rows() + 1, 3);
+  unused.V.bottomRows(1).setZero();
+  EXPECT_THROW(harmonic_function(unused), MeshError);
+}
+
+}  // namespace
+}  // namespace polycube
