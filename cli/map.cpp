@@ -3,7 +3,9 @@
 #include "cli/mesh_input.h"
 #include "cli/stage_json.h"
 
+#include "applications/preview/render.h"
 #include "formats/atomic_file.h"
+#include "formats/image_io.h"
 #include "formats/mesh_io.h"
 #include "polycube/errors.h"
 #include "polycube/topology.h"
@@ -45,14 +47,31 @@ Eigen::Vector3d index_colour(int index) {
   }
 }
 
+Eigen::MatrixX3d piece_colours(const SlicedMesh& sliced) {
+  Eigen::MatrixX3d rgb(sliced.mesh.num_faces(), 3);
+  for (int f = 0; f < sliced.mesh.num_faces(); ++f) rgb.row(f) = index_colour(sliced.face_piece[f]);
+  return rgb;
+}
+
 // The sliced model with each face coloured by its piece, for viewing in MeshLab or Blender.
 void write_pieces(const std::string& path, const SlicedMesh& sliced) {
   MeshColors colours;
-  colours.face_rgb.resize(sliced.mesh.num_faces(), 3);
-  for (int f = 0; f < sliced.mesh.num_faces(); ++f) colours.face_rgb.row(f) = index_colour(sliced.face_piece[f]);
+  colours.face_rgb = piece_colours(sliced);
   std::vector<std::vector<int>> faces(sliced.mesh.num_faces());
   for (int f = 0; f < sliced.mesh.num_faces(); ++f) faces[f] = {sliced.mesh.F(f, 0), sliced.mesh.F(f, 1), sliced.mesh.F(f, 2)};
   write_polygon_mesh(path, sliced.mesh.V, faces, &colours);
+}
+
+// A picture of the pieces: the model from a 3/4 view in front and from behind.
+void write_pieces_preview(const std::string& path, const SlicedMesh& sliced) {
+  const Eigen::MatrixX3d rgb = piece_colours(sliced);
+  RenderItem item;
+  item.mesh = &sliced.mesh;
+  item.face_rgb = &rgb;
+  RenderItem back = item;
+  back.view_direction = {-item.view_direction.x(), -item.view_direction.y(), item.view_direction.z()};
+  const Image image = render_tiles({item, back});
+  write_image(path, image);
 }
 
 int run_map(const MapOptions& options, const GlobalOptions& global) {
@@ -81,6 +100,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   const std::string pieces_path = (dir / "pieces.ply").string();
   write_pieces(pieces_path, topology.sliced);
   outputs.push_back(pieces_path);
+  const std::string preview_path = (dir / "preview.png").string();
+  write_pieces_preview(preview_path, topology.sliced);
+  outputs.push_back(preview_path);
 
   report["seconds"] = {{"topology", topology.seconds_total}, {"total", progress.elapsed_seconds()}};
   const std::string report_path = (dir / "report.json").string();

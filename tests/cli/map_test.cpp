@@ -1,4 +1,5 @@
 // End-to-end: `polycube map` through the real binary: outputs, report, and clean failures.
+#include "formats/image_io.h"
 #include "formats/mesh_io.h"
 #include "support/test_support.h"
 
@@ -40,6 +41,10 @@ TEST(MapCli, TopologyStageWritesReportAndPieces) {
   for (const auto& piece : topology.at("pieces")) triangles += piece.at("triangles").get<int>();
   EXPECT_EQ(static_cast<int>(pieces.polygons.size()), triangles);
   EXPECT_GE(pieces.polygons.size(), report.at("input").at("faces").get<size_t>());
+
+  const Image preview = read_image(dir + "/preview.png");
+  EXPECT_GT(preview.width, preview.height) << "views side by side";
+  EXPECT_GE(preview.height, 256);
 
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << "no temporary left behind";
