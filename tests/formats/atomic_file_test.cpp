@@ -18,18 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void put(const std::string& path, const std::string& contents) {
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-}
-
 std::vector<std::string> entries(const std::string& dir) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
@@ -51,16 +39,16 @@ TEST(AtomicFile, WritesTheFileAndLeavesNoTemporary) {
   const std::string dir = test::temp_dir("atomic");
   const std::string path = dir + "/out.txt";
   write_text_atomically(path, [](std::ostream& out) { out << "hello\n"; });
-  EXPECT_EQ(slurp(path), "hello\n");
+  EXPECT_EQ(test::read_file(path), "hello\n");
   EXPECT_EQ(entries(dir), std::vector<std::string>{"out.txt"});
 }
 
 TEST(AtomicFile, ReplacesAnExistingFile) {
   const std::string dir = test::temp_dir("atomic");
   const std::string path = dir + "/out.txt";
-  put(path, "old contents that are longer than the new ones");
+  test::write_file(path, "old contents that are longer than the new ones");
   write_text_atomically(path, [](std::ostream& out) { out << "new"; });
-  EXPECT_EQ(slurp(path), "new");
+  EXPECT_EQ(test::read_file(path), "new");
   EXPECT_EQ(entries(dir).size(), 1u);
 }
 
@@ -82,7 +70,7 @@ TEST(AtomicFile, TemporaryIsAFreshHiddenFileInTheSameDirectory) {
     EXPECT_EQ(fs::path(temp).filename().string().rfind(".mesh.ply.tmp-" + std::to_string(::getpid()) + "-", 0), 0u)
         << temp;
   }
-  EXPECT_EQ(slurp(path), "1");
+  EXPECT_EQ(test::read_file(path), "1");
 }
 
 TEST(AtomicFile, ThrowingWriterLeavesNoFileAndPropagatesItsException) {
@@ -107,14 +95,14 @@ TEST(AtomicFile, ThrowingWriterLeavesNoFileAndPropagatesItsException) {
 TEST(AtomicFile, ThrowingWriterKeepsThePreviousVersion) {
   const std::string dir = test::temp_dir("atomic");
   const std::string path = dir + "/out.txt";
-  put(path, "previous");
+  test::write_file(path, "previous");
   EXPECT_THROW(write_text_atomically(path,
                                      [](std::ostream& out) {
                                        out << "partial";
                                        throw std::runtime_error("writer failed");
                                      }),
                std::runtime_error);
-  EXPECT_EQ(slurp(path), "previous");
+  EXPECT_EQ(test::read_file(path), "previous");
   EXPECT_EQ(entries(dir).size(), 1u);
 }
 
@@ -140,7 +128,7 @@ TEST(AtomicFile, MissingDirectoryIsAnOutputError) {
 
 TEST(AtomicFile, ParentThatIsAFileIsAnOutputError) {
   const std::string dir = test::temp_dir("atomic");
-  put(dir + "/plain", "a file, not a directory");
+  test::write_file(dir + "/plain", "a file, not a directory");
   const std::string path = dir + "/plain/out.txt";
   expect_output_error(path, [&] { write_text_atomically(path, [](std::ostream& out) { out << "x"; }); });
 }
@@ -170,7 +158,7 @@ TEST(AtomicFile, RelativePathIsWrittenInTheWorkingDirectory) {
   fs::current_path(dir);
   write_text_atomically("relative.txt", [](std::ostream& out) { out << "here"; });
   fs::current_path(previous);
-  EXPECT_EQ(slurp(dir + "/relative.txt"), "here");
+  EXPECT_EQ(test::read_file(dir + "/relative.txt"), "here");
   EXPECT_EQ(entries(dir).size(), 1u);
 }
 
@@ -186,7 +174,7 @@ TEST(AtomicFile, ConcurrentWritersNeverMixTheirOutputs) {
       for (int r = 0; r < rounds; ++r) write_text_atomically(path, [&](std::ostream& out) { out << contents(w); });
     });
   for (std::thread& t : threads) t.join();
-  const std::string result = slurp(path);
+  const std::string result = test::read_file(path);
   ASSERT_EQ(result.size(), 200000u);
   EXPECT_EQ(result, contents(result[0] - 'a'));
   EXPECT_EQ(entries(dir), std::vector<std::string>{"shared.txt"});

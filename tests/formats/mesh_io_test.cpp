@@ -23,19 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string put(const std::string& path, const std::string& contents) {
-  std::ofstream out(path, std::ios::binary);
-  out << contents;
-  return path;
-}
-
 std::vector<std::string> entries(const std::string& dir) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
@@ -111,7 +98,7 @@ TEST_P(MeshRoundTrip, ColouredMeshReadsBackItsGeometry) {
   colors.face_rgb = Eigen::MatrixX3d::Random(6, 3).cwiseAbs();
   write_polygon_mesh(path, awkward_vertices(), mixed_polygons(), &colors);
   expect_same(read_polygon_soup(path), awkward_vertices(), mixed_polygons());
-  const std::string contents = slurp(path);
+  const std::string contents = test::read_file(path);
   if (GetParam() == ".ply") {
     EXPECT_NE(contents.find("element vertex 8\nproperty double x\nproperty double y\nproperty double z\n"
                             "property uchar red\nproperty uchar green\nproperty uchar blue\n"),
@@ -144,7 +131,7 @@ TEST(MeshWrite, PlyIsBinaryLittleEndianWithDoubles) {
   Eigen::MatrixX3d V(3, 3);
   V << 1, 2, 3, 4, 5, 6, 7, 8, 9.5;
   write_polygon_mesh(path, V, {{0, 1, 2}});
-  const std::string contents = slurp(path);
+  const std::string contents = test::read_file(path);
   const std::string header =
       "ply\nformat binary_little_endian 1.0\ncomment written by polycube\nelement vertex 3\n"
       "property double x\nproperty double y\nproperty double z\nelement face 1\n"
@@ -190,7 +177,7 @@ TEST(MeshWrite, MissingDirectoryIsAnOutputError) {
 // ---- PLY and STL written by other tools ----------------------------------------------------
 
 TEST(PlyRead, AsciiWithColoursAndExtraProperties) {
-  const std::string path = put(test::temp_dir("ply") + "/ascii.ply",
+  const std::string path = test::write_file(test::temp_dir("ply") + "/ascii.ply",
                                "ply\n"
                                "format ascii 1.0\n"
                                "comment written by hand\n"
@@ -237,7 +224,7 @@ TEST(PlyRead, BinaryBigEndianWithVertexIndex) {
   for (float value : {1.5f, -2.0f, 3.25f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f}) append_big_endian(contents, value);
   contents += static_cast<char>(3);
   for (std::uint32_t index : {2u, 0u, 1u}) append_big_endian(contents, index);
-  const PolygonSoup soup = read_polygon_soup(put(test::temp_dir("ply") + "/big.ply", contents));
+  const PolygonSoup soup = read_polygon_soup(test::write_file(test::temp_dir("ply") + "/big.ply", contents));
   ASSERT_EQ(soup.points.size(), 3u);
   EXPECT_EQ(soup.points[0], Eigen::Vector3d(1.5, -2.0, 3.25));
   EXPECT_EQ(soup.polygons, (std::vector<std::vector<int>>{{2, 0, 1}}));
@@ -286,14 +273,14 @@ void expect_indexed_tetrahedron(const PolygonSoup& soup) {
 
 TEST(StlRead, BinaryIsIndexed) {
   const std::string dir = test::temp_dir("stl");
-  expect_indexed_tetrahedron(read_polygon_soup(put(dir + "/tetra.stl", binary_stl(tetrahedron_triangles()))));
+  expect_indexed_tetrahedron(read_polygon_soup(test::write_file(dir + "/tetra.stl", binary_stl(tetrahedron_triangles()))));
 }
 
 TEST(StlRead, BinaryWhoseHeaderStartsWithSolid) {
   // Some CAD exporters write "solid" into the binary header; the file size tells it apart.
   const std::string dir = test::temp_dir("stl");
   expect_indexed_tetrahedron(
-      read_polygon_soup(put(dir + "/tetra.STL", binary_stl(tetrahedron_triangles(), "solid exported by CAD"))));
+      read_polygon_soup(test::write_file(dir + "/tetra.STL", binary_stl(tetrahedron_triangles(), "solid exported by CAD"))));
 }
 
 TEST(StlRead, AsciiIsIndexed) {
@@ -306,25 +293,25 @@ TEST(StlRead, AsciiIsIndexed) {
     text += "    endloop\n  endfacet\n";
   }
   text += "endsolid tetra\n";
-  expect_indexed_tetrahedron(read_polygon_soup(put(test::temp_dir("stl") + "/tetra.stl", text)));
+  expect_indexed_tetrahedron(read_polygon_soup(test::write_file(test::temp_dir("stl") + "/tetra.stl", text)));
 }
 
 TEST(StlRead, AsciiErrorsHaveLineNumbers) {
   const std::string dir = test::temp_dir("stl");
   const std::string head = "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n";
-  expect_input_error(put(dir + "/a.stl", head + "vertex 0 1\nendloop\nendfacet\nendsolid\n"),
+  expect_input_error(test::write_file(dir + "/a.stl", head + "vertex 0 1\nendloop\nendfacet\nendsolid\n"),
                      "line 6: expected 3 coordinates, got 2");
-  expect_input_error(put(dir + "/b.stl", head + "vertex 0 nan 0\nendloop\nendfacet\nendsolid\n"),
+  expect_input_error(test::write_file(dir + "/b.stl", head + "vertex 0 nan 0\nendloop\nendfacet\nendsolid\n"),
                      "line 6: non-finite coordinate (nan)");
-  expect_input_error(put(dir + "/c.stl", head + "vertex 0 1 0\nvertex 1 1 0\nendloop\nendfacet\nendsolid\n"),
+  expect_input_error(test::write_file(dir + "/c.stl", head + "vertex 0 1 0\nvertex 1 1 0\nendloop\nendfacet\nendsolid\n"),
                      "line 9: facet has 4 vertices");
-  expect_input_error(put(dir + "/d.stl", head + "vertex 0 1 0\nendloop\nendfacet\n"), "truncated");
+  expect_input_error(test::write_file(dir + "/d.stl", head + "vertex 0 1 0\nendloop\nendfacet\n"), "truncated");
 }
 
 TEST(StlRead, NonFiniteBinaryCoordinateIsAnError) {
   auto triangles = tetrahedron_triangles();
   triangles[2][4] = std::numeric_limits<float>::quiet_NaN();
-  expect_input_error(put(test::temp_dir("stl") + "/nan.stl", binary_stl(triangles)), "triangle 2 has a non-finite");
+  expect_input_error(test::write_file(test::temp_dir("stl") + "/nan.stl", binary_stl(triangles)), "triangle 2 has a non-finite");
 }
 
 // ---- truncated and corrupt binary files ----------------------------------------------------
@@ -333,21 +320,21 @@ TEST(BinaryRead, TruncatedPlyIsAnInputError) {
   const std::string dir = test::temp_dir("truncated");
   const std::string path = dir + "/mesh.ply";
   write_polygon_mesh(path, awkward_vertices(), mixed_polygons());
-  const std::string whole = slurp(path);
+  const std::string whole = test::read_file(path);
   const std::size_t header = whole.find("end_header\n") + 11;
   for (std::size_t cut : {std::size_t{1}, std::size_t{5}, whole.size() - header - 8 * 24, whole.size() - header})
-    expect_input_error(put(dir + "/cut.ply", whole.substr(0, whole.size() - cut)), "truncated: header announces");
-  expect_input_error(put(dir + "/cut.ply", whole.substr(0, whole.size() - 1)),
+    expect_input_error(test::write_file(dir + "/cut.ply", whole.substr(0, whole.size() - cut)), "truncated: header announces");
+  expect_input_error(test::write_file(dir + "/cut.ply", whole.substr(0, whole.size() - 1)),
                      "header announces 8 vertices and 6 faces, file ends after 8 vertices and 5 faces");
-  expect_input_error(put(dir + "/cut.ply", whole.substr(0, header - 5)), "no end_header");
+  expect_input_error(test::write_file(dir + "/cut.ply", whole.substr(0, header - 5)), "no end_header");
 }
 
 TEST(BinaryRead, TruncatedStlIsAnInputError) {
   const std::string dir = test::temp_dir("truncated");
   const std::string whole = binary_stl(tetrahedron_triangles());
-  expect_input_error(put(dir + "/cut.stl", whole.substr(0, whole.size() - 1)),
+  expect_input_error(test::write_file(dir + "/cut.stl", whole.substr(0, whole.size() - 1)),
                      "truncated: header announces 4 triangles (284 bytes), file has 283 bytes");
-  expect_input_error(put(dir + "/cut.stl", whole.substr(0, 60)), "truncated");
+  expect_input_error(test::write_file(dir + "/cut.stl", whole.substr(0, 60)), "truncated");
 }
 
 TEST(BinaryRead, CorruptPlyBodyIsAnInputError) {
@@ -357,7 +344,7 @@ TEST(BinaryRead, CorruptPlyBodyIsAnInputError) {
       "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n";
   contents += std::string(36, '\0');
   contents += std::string(4, '\xFF') + std::string(12, '\0');
-  expect_input_error(put(test::temp_dir("corrupt") + "/huge.ply", contents), "truncated");
+  expect_input_error(test::write_file(test::temp_dir("corrupt") + "/huge.ply", contents), "truncated");
 }
 
 TEST(BinaryRead, UnsupportedPlyHeadersAreInputErrors) {
@@ -366,21 +353,21 @@ TEST(BinaryRead, UnsupportedPlyHeadersAreInputErrors) {
   const std::string face =
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n0 0 1\n0 1 0\n3 0 1 2\n";
   // CGAL's reader would dereference a null pointer on integer coordinates.
-  expect_input_error(put(dir + "/int.ply", vertex + "property int x\nproperty int y\nproperty int z\n" + face),
+  expect_input_error(test::write_file(dir + "/int.ply", vertex + "property int x\nproperty int y\nproperty int z\n" + face),
                      "vertex property 'x' has type 'int'");
-  expect_input_error(put(dir + "/early.ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n"),
+  expect_input_error(test::write_file(dir + "/early.ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n"),
                      "line 3: property before any element");
-  expect_input_error(put(dir + "/noz.ply", vertex + "property float x\nproperty float y\n" + face), "no property 'z'");
-  expect_input_error(put(dir + "/type.ply", vertex + "property float x\nproperty float y\nproperty real z\n" + face),
+  expect_input_error(test::write_file(dir + "/noz.ply", vertex + "property float x\nproperty float y\n" + face), "no property 'z'");
+  expect_input_error(test::write_file(dir + "/type.ply", vertex + "property float x\nproperty float y\nproperty real z\n" + face),
                      "line 6: unknown property type 'real'");
-  expect_input_error(put(dir + "/short.ply", vertex + "property float x\nproperty float y\nproperty float z\n" +
+  expect_input_error(test::write_file(dir + "/short.ply", vertex + "property float x\nproperty float y\nproperty float z\n" +
                                                  "element face 1\nproperty list uchar short vertex_indices\n"
                                                  "end_header\n0 0 0\n0 0 1\n0 1 0\n3 0 1 2\n"),
                      "supported: int, uint");
-  expect_input_error(put(dir + "/empty-element.ply", "ply\nformat ascii 1.0\nelement junk 999999999999\nend_header\n"),
+  expect_input_error(test::write_file(dir + "/empty-element.ply", "ply\nformat ascii 1.0\nelement junk 999999999999\nend_header\n"),
                      "no properties");
-  expect_input_error(put(dir + "/notply.ply", "PLY\n"), "not a PLY file");
-  expect_input_error(put(dir + "/points.ply", vertex + "property float x\nproperty float y\nproperty float z\n"
+  expect_input_error(test::write_file(dir + "/notply.ply", "PLY\n"), "not a PLY file");
+  expect_input_error(test::write_file(dir + "/points.ply", vertex + "property float x\nproperty float y\nproperty float z\n"
                                                        "end_header\n0 0 0\n0 0 1\n0 1 0\n"),
                      "no face element");
 }
@@ -390,19 +377,19 @@ TEST(BinaryRead, AsciiPlyErrorsHaveLineNumbers) {
   const std::string header =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
-  expect_input_error(put(dir + "/nan.ply", header + "0 0 0\n0 nan 1\n0 1 0\n3 0 1 2\n"),
+  expect_input_error(test::write_file(dir + "/nan.ply", header + "0 0 0\n0 nan 1\n0 1 0\n3 0 1 2\n"),
                      "line 11: vertex 1 has a non-finite value (nan)");
-  expect_input_error(put(dir + "/word.ply", header + "0 0 0\n0 0 1\n0 x 0\n3 0 1 2\n"),
+  expect_input_error(test::write_file(dir + "/word.ply", header + "0 0 0\n0 0 1\n0 x 0\n3 0 1 2\n"),
                      "line 12: vertex 2: 'x' is not");
-  expect_input_error(put(dir + "/float-index.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 1.5 2\n"),
+  expect_input_error(test::write_file(dir + "/float-index.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 1.5 2\n"),
                      "line 13: face 0: property 'vertex_indices' needs an integer of type int, got '1.5'");
-  expect_input_error(put(dir + "/long-list.ply", header + "0 0 0\n0 0 1\n0 1 0\n300 0 1 2\n"),
+  expect_input_error(test::write_file(dir + "/long-list.ply", header + "0 0 0\n0 0 1\n0 1 0\n300 0 1 2\n"),
                      "needs an integer of type uchar, got '300'");
-  expect_input_error(put(dir + "/short.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 1\n"),
+  expect_input_error(test::write_file(dir + "/short.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 1\n"),
                      "truncated: header announces 3 vertices and 1 faces, file ends after 3 vertices and 0 faces");
-  expect_input_error(put(dir + "/index.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 1 3\n"),
+  expect_input_error(test::write_file(dir + "/index.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 1 3\n"),
                      "face 0 refers to vertex 3, but the file has 3 vertices");
-  expect_input_error(put(dir + "/negative.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 -1 2\n"), "refers to vertex -1");
+  expect_input_error(test::write_file(dir + "/negative.ply", header + "0 0 0\n0 0 1\n0 1 0\n3 0 -1 2\n"), "refers to vertex -1");
 }
 
 // Every prefix and many random corruptions of a valid file either read or throw InputError:
@@ -412,7 +399,7 @@ TEST(BinaryRead, PrefixesAndCorruptionsNeverCrash) {
   std::vector<std::pair<std::string, std::string>> files;  // extension, contents
   for (const char* extension : {".obj", ".off", ".ply"}) {
     write_polygon_mesh(dir + "/mesh" + extension, awkward_vertices(), mixed_polygons());
-    files.emplace_back(extension, slurp(dir + "/mesh" + extension));
+    files.emplace_back(extension, test::read_file(dir + "/mesh" + extension));
   }
   files.emplace_back(".stl", binary_stl(tetrahedron_triangles()));
   std::mt19937 random(12345);
@@ -427,7 +414,7 @@ TEST(BinaryRead, PrefixesAndCorruptionsNeverCrash) {
       variants.push_back(corrupt);
     }
     for (const std::string& contents : variants) {
-      put(path, contents);
+      test::write_file(path, contents);
       try {
         read_polygon_soup(path);
       } catch (const InputError& e) {
@@ -440,7 +427,7 @@ TEST(BinaryRead, PrefixesAndCorruptionsNeverCrash) {
 // ---- OBJ -----------------------------------------------------------------------------------
 
 TEST(ObjRead, StatementsAndIndexForms) {
-  const std::string path = put(test::temp_dir("obj") + "/forms.obj",
+  const std::string path = test::write_file(test::temp_dir("obj") + "/forms.obj",
                                "# exported\n"
                                "mtllib forms.mtl\n"
                                "o thing\n"
@@ -486,7 +473,7 @@ TEST(ObjRead, ErrorsNameTheLineAndTheProblem) {
       {"hello world\nfoo\n" + triangle + "f 1 2 3\nbar\nbaz\nqux\nquux\nx\n", "not an OBJ file: 7 of 11"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i)
-    expect_input_error(put(dir + "/case" + std::to_string(i) + ".obj", cases[i].first), cases[i].second);
+    expect_input_error(test::write_file(dir + "/case" + std::to_string(i) + ".obj", cases[i].first), cases[i].second);
 }
 
 TEST(ObjRead, RockerArm) {
@@ -502,7 +489,7 @@ TEST(OffRead, VariantsCommentsAndColours) {
   const std::string dir = test::temp_dir("off");
   const std::vector<std::vector<int>> triangle = {{0, 1, 2}};
   // Counts on the header line, colours on vertices and faces, comments, CRLF, blank lines.
-  PolygonSoup soup = read_polygon_soup(put(dir + "/coff.off",
+  PolygonSoup soup = read_polygon_soup(test::write_file(dir + "/coff.off",
                                            "# leading comment\r\n"
                                            "COFF 3 1 0  # counts here\r\n"
                                            "\r\n"
@@ -514,7 +501,7 @@ TEST(OffRead, VariantsCommentsAndColours) {
   ASSERT_EQ(soup.points.size(), 3u);
   EXPECT_EQ(soup.points[2], Eigen::Vector3d(0, 1, 0.5));
   EXPECT_EQ(soup.polygons, triangle);
-  soup = read_polygon_soup(put(dir + "/noff.OFF", "NOFF\n3 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n"));
+  soup = read_polygon_soup(test::write_file(dir + "/noff.OFF", "NOFF\n3 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n"));
   EXPECT_EQ(soup.polygons, triangle);
 }
 
@@ -541,7 +528,7 @@ TEST(OffRead, ErrorsNameTheLineAndTheProblem) {
       {"OFF\n0 0 0\n", "no vertices"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i)
-    expect_input_error(put(dir + "/case" + std::to_string(i) + ".off", cases[i].first), cases[i].second);
+    expect_input_error(test::write_file(dir + "/case" + std::to_string(i) + ".off", cases[i].first), cases[i].second);
 }
 
 // ---- the test data -------------------------------------------------------------------------
@@ -554,9 +541,9 @@ TEST(DataFiles, UnparsableBadFilesAreInputErrors) {
   expect_input_error(test::data_path("bad/nan-and-bad-index.off"),
                      "line 6: vertex 3 has a non-finite coordinate (nan)");
   // With the NaN fixed, the bad index is reported.
-  std::string fixed = slurp(test::data_path("bad/nan-and-bad-index.off"));
+  std::string fixed = test::read_file(test::data_path("bad/nan-and-bad-index.off"));
   fixed.replace(fixed.find("nan"), 3, "0");
-  expect_input_error(put(test::temp_dir("data") + "/bad-index.off", fixed),
+  expect_input_error(test::write_file(test::temp_dir("data") + "/bad-index.off", fixed),
                      "line 8: face 1 refers to vertex 7, but the file has 4 vertices");
 }
 
@@ -594,10 +581,10 @@ TEST(DataFiles, MissingDirectoryAndUnsupported) {
   const std::string dir = test::temp_dir("data");
   fs::create_directory(dir + "/folder.off");
   expect_input_error(dir + "/folder.off", "is a directory");
-  expect_input_error(put(dir + "/points.xyz", "0 0 0\n"), "unsupported format '.xyz' (supported: .obj .off .ply .stl)");
-  expect_input_error(put(dir + "/noextension", "OFF\n"), "unsupported format ''");
-  expect_input_error(put(dir + "/empty.stl", ""), "file is empty");
-  expect_input_error(put(dir + "/empty.ply", ""), "file is empty");
+  expect_input_error(test::write_file(dir + "/points.xyz", "0 0 0\n"), "unsupported format '.xyz' (supported: .obj .off .ply .stl)");
+  expect_input_error(test::write_file(dir + "/noextension", "OFF\n"), "unsupported format ''");
+  expect_input_error(test::write_file(dir + "/empty.stl", ""), "file is empty");
+  expect_input_error(test::write_file(dir + "/empty.ply", ""), "file is empty");
 }
 
 TEST(DataFiles, ExtensionIsCaseInsensitive) {

@@ -47,22 +47,26 @@ std::string temp_dir(const std::string& tag) {
   return dir.string();
 }
 
-namespace {
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
 }
-}  // namespace
+
+std::string write_file(const std::string& path, const std::string& contents) {
+  std::ofstream out(path, std::ios::binary);
+  out << contents;
+  return path;
+}
 
 int run_command(const std::string& command, std::string* out, std::string* err) {
   const std::string dir = temp_dir("cmd");
   const std::string out_path = dir + "/stdout", err_path = dir + "/stderr";
   const std::string full = command + " > '" + out_path + "' 2> '" + err_path + "' < /dev/null";
   const int status = std::system(full.c_str());
-  if (out) *out = slurp(out_path);
-  if (err) *err = slurp(err_path);
+  if (out) *out = read_file(out_path);
+  if (err) *err = read_file(err_path);
   std::filesystem::remove_all(dir);
   if (status == -1) return -1;
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -29,6 +29,12 @@ std::string binary_path();
 // A fresh empty directory under the system temp dir, removed by nobody (ctest runs are short).
 std::string temp_dir(const std::string& tag);
 
+// Whole contents of a file (binary); empty when it cannot be read.
+std::string read_file(const std::string& path);
+
+// Writes contents to path (binary), replacing it; returns path.
+std::string write_file(const std::string& path, const std::string& contents);
+
 // Runs a shell command; returns its exit code and fills stdout/stderr when given.
 int run_command(const std::string& command, std::string* out = nullptr, std::string* err = nullptr);
 
