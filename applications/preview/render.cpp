@@ -22,7 +22,8 @@ struct View {
   }
 };
 
-View frame(const RenderItem& item, const RenderOptions& options, int width, int height) {
+// Frames the item to fill a width by height tile; with max_scale > 0 the scale is at most that.
+View frame(const RenderItem& item, const RenderOptions& options, int width, int height, double max_scale = 0) {
   const TriMesh& mesh = *item.mesh;
   View view;
   view.forward = item.view_direction.normalized();
@@ -39,6 +40,7 @@ View frame(const RenderItem& item, const RenderOptions& options, int width, int 
   const double margin = 0.92;
   const double span = std::max({x1 - x0, (y1 - y0) * width / static_cast<double>(height), 1e-300});
   view.scale = margin * width / span;
+  if (max_scale > 0) view.scale = std::min(view.scale, max_scale);
   view.offset_x = 0.5 * width - view.scale * 0.5 * (x0 + x1);
   view.offset_y = 0.5 * height + view.scale * 0.5 * (y0 + y1);
   return view;
@@ -65,9 +67,10 @@ Eigen::Vector3d checker_colour(const Eigen::Vector3d& p, double size) {
 }
 
 // Rasterises one item into a supersampled colour/depth buffer of w by h samples.
-void rasterise(const RenderItem& item, const RenderOptions& options, int w, int h, std::vector<Eigen::Vector3f>& colour) {
+void rasterise(const RenderItem& item, const RenderOptions& options, int w, int h, double max_scale,
+               std::vector<Eigen::Vector3f>& colour) {
   const TriMesh& mesh = *item.mesh;
-  const View view = frame(item, options, w, h);
+  const View view = frame(item, options, w, h, max_scale);
   std::vector<Eigen::Vector3d> screen(mesh.num_vertices());
   for (int v = 0; v < mesh.num_vertices(); ++v) screen[v] = view.project(mesh.V.row(v).transpose());
   const Eigen::MatrixX3d normals = item.smooth ? vertex_normals(mesh) : Eigen::MatrixX3d();
@@ -128,6 +131,12 @@ Image render_tiles(const std::vector<RenderItem>& items, const RenderOptions& op
   image.height = options.tile_height;
   image.channels = 3;
   image.pixels.assign(static_cast<size_t>(image.width) * image.height * 3, 0.0f);
+  double max_scale = 0;  // the smallest of the items' own scales, when they share one
+  if (options.same_scale) {
+    max_scale = std::numeric_limits<double>::infinity();
+    for (const RenderItem& item : items)
+      if (item.mesh && item.mesh->num_faces() > 0) max_scale = std::min(max_scale, frame(item, options, w, h).scale);
+  }
   for (size_t t = 0; t < items.size(); ++t) {
     const RenderItem& item = items[t];
     if (!item.mesh || item.mesh->num_faces() == 0) throw AlgorithmError("render_tiles: item without faces");
@@ -136,7 +145,7 @@ Image render_tiles(const std::vector<RenderItem>& items, const RenderOptions& op
     if (item.face_rgb && item.face_rgb->rows() != item.mesh->num_faces())
       throw AlgorithmError("render_tiles: face_rgb needs one row per face");
     std::vector<Eigen::Vector3f> samples(static_cast<size_t>(w) * h, options.background.cast<float>());
-    rasterise(item, options, w, h, samples);
+    rasterise(item, options, w, h, max_scale, samples);
     // Box-filter the samples down to pixels.
     for (int y = 0; y < options.tile_height; ++y)
       for (int x = 0; x < options.tile_width; ++x) {

@@ -35,6 +35,9 @@ struct RenderOptions {
   int tile_height = 640;
   int supersampling = 2;  // samples per pixel per axis, averaged
   Eigen::Vector3d up{0, 0, 1};
+  // Draw every tile at the scale of the largest item, so sizes compare across tiles (a model and
+  // its polycube); false frames each item to fill its own tile.
+  bool same_scale = false;
   Eigen::Vector3d background{1, 1, 1};
 };
 

@@ -102,6 +102,26 @@ TEST(Render, CheckerAndFaceColoursShowUp) {
   EXPECT_GT(bluish, 1000);
 }
 
+TEST(Render, SameScaleDrawsASmallerObjectSmaller) {
+  const TriMesh big = test::make_sphere(2);
+  TriMesh small = big;
+  small.V *= 0.5;
+  RenderItem a, b;
+  a.mesh = &big;
+  b.mesh = &small;
+  RenderOptions options;
+  options.tile_width = options.tile_height = 100;
+  options.same_scale = true;
+  const Image image = render_tiles({a, b}, options);
+  auto covered = [&](int tile) {
+    int count = 0;
+    for (int y = 0; y < 100; ++y)
+      for (int x = 0; x < 100; ++x) count += !is_background(image, tile * 100 + x, y);
+    return count;
+  };
+  EXPECT_NEAR(covered(1) / static_cast<double>(covered(0)), 0.25, 0.03) << "half the radius, a quarter of the area";
+}
+
 TEST(Render, RejectsInconsistentInput) {
   const TriMesh sphere = test::make_sphere(1);
   Eigen::MatrixX3d wrong(3, 3);
