@@ -8,26 +8,34 @@
 #include "formats/image_io.h"
 #include "formats/mesh_io.h"
 #include "polycube/errors.h"
+#include "polycube/polycube_build.h"
 #include "polycube/topology.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
+#include <optional>
 
 namespace polycube::cli {
 
 namespace {
 
 // The stages `map` can stop after, in pipeline order. The default is the last one built.
-const std::vector<std::string> kStages = {"topology"};
+const std::vector<std::string> kStages = {"topology", "polycube"};
+
+bool runs(const std::string& stop_after, const std::string& stage) {
+  const auto at = [](const std::string& s) { return std::find(kStages.begin(), kStages.end(), s) - kStages.begin(); };
+  return at(stage) <= at(stop_after);
+}
 
 struct MapOptions {
   MeshInput input;
   std::string output_dir;
   std::string stage = kStages.back();
   TopologyOptions topology;
-  double da = 0.3;
+  PolycubeOptions polycube;
 };
 
 // A distinct, light colour per index (golden-ratio hue steps), RGB in [0,1].
@@ -70,8 +78,52 @@ void write_pieces_preview(const std::string& path, const SlicedMesh& sliced) {
   item.face_rgb = &rgb;
   RenderItem back = item;
   back.view_direction = {-item.view_direction.x(), -item.view_direction.y(), item.view_direction.z()};
-  const Image image = render_tiles({item, back});
-  write_image(path, image);
+  write_image(path, render_tiles({item, back}));
+}
+
+// The model and the polycube side by side, each piece of P in the colour of its model piece.
+void write_polycube_preview(const std::string& path, const PolycubeResult& result) {
+  const Eigen::MatrixX3d model_rgb = piece_colours(result.model_sliced);
+  std::vector<int> model_piece_of(result.polycube_sliced.pieces.size(), 0);
+  for (size_t m = 0; m < result.piece_match.size(); ++m) model_piece_of[result.piece_match[m]] = static_cast<int>(m);
+  const TriMesh& cube = result.polycube_sliced.mesh;
+  Eigen::MatrixX3d cube_rgb(cube.num_faces(), 3);
+  for (int f = 0; f < cube.num_faces(); ++f) cube_rgb.row(f) = index_colour(model_piece_of[result.polycube_sliced.face_piece[f]]);
+  RenderItem model, polycube;
+  model.mesh = &result.model_sliced.mesh;
+  model.face_rgb = &model_rgb;
+  polycube.mesh = &cube;
+  polycube.face_rgb = &cube_rgb;
+  polycube.smooth = false;
+  RenderOptions options;
+  options.same_scale = true;
+  write_image(path, render_tiles({model, polycube}, options));
+}
+
+nlohmann::json polycube_json(const PolycubeResult& result) {
+  const Polycube& p = result.polycube;
+  return {{"vertices", p.mesh.num_vertices()},
+          {"triangles", p.mesh.num_faces()},
+          {"faces", p.faces.size()},
+          {"edges", p.edges.size()},
+          {"corners", p.corners.size()},
+          {"genus", result.genus},
+          {"planes", result.planes_z},
+          {"pieces", result.polycube_sliced.pieces.size()},
+          {"planes_inserted", result.planes_inserted},
+          {"quadtree_splits", {{"accuracy", result.accuracy_splits},
+                               {"section_topology", result.section_splits},
+                               {"stacking", result.stacking_splits}}},
+          {"relabelled_cells", result.relabelled_cells},
+          {"rounds", result.rounds},
+          {"deepest_level", result.deepest_level},
+          {"max_region_area_error", result.max_region_error},
+          {"repairs", result.repairs},
+          {"seconds", {{"quadtrees", result.seconds_quadtrees},
+                       {"checks", result.seconds_checks},
+                       {"surface", result.seconds_surface},
+                       {"verify", result.seconds_verify},
+                       {"total", result.seconds_total}}}};
 }
 
 int run_map(const MapOptions& options, const GlobalOptions& global) {
@@ -88,7 +140,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   nlohmann::json report;
   report["input"] = diagnosis_json(prepared);
   report["input"]["file"] = options.input.path;
-  report["parameters"] = {{"dz", options.topology.dz}, {"da", options.da}, {"stage", options.stage}};
+  report["parameters"] = {{"dz", options.topology.dz}, {"da", options.polycube.da}, {"stage", options.stage}};
   std::vector<std::string> outputs;
 
   progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
@@ -97,14 +149,36 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   progress.stage("topology", std::to_string(topology.critical.saddle_count()) + " saddles, " +
                                  std::to_string(topology.planes_z.size()) + " planes, " +
                                  std::to_string(topology.sliced.pieces.size()) + " genus-0 pieces");
+  nlohmann::json seconds = {{"topology", topology.seconds_total}};
+  const SlicedMesh* model_pieces = &topology.sliced;
+  std::optional<PolycubeResult> polycube;
+  if (runs(options.stage, "polycube")) {
+    progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
+    polycube = build_polycube(prepared.mesh, topology, options.polycube);
+    model_pieces = &polycube->model_sliced;
+    report["polycube"] = polycube_json(*polycube);
+    seconds["polycube"] = polycube->seconds_total;
+    for (const std::string& repair : polycube->repairs) progress.warning("polycube: " + repair);
+    progress.stage("polycube", std::to_string(polycube->polycube.corners.size()) + " corners, " +
+                                   std::to_string(polycube->polycube.faces.size()) + " faces, " +
+                                   std::to_string(polycube->polycube_sliced.pieces.size()) + " pieces matched");
+    const std::string polycube_path = (dir / "polycube.obj").string();
+    write_mesh(polycube_path, polycube->polycube.mesh);
+    outputs.push_back(polycube_path);
+  }
+
   const std::string pieces_path = (dir / "pieces.ply").string();
-  write_pieces(pieces_path, topology.sliced);
+  write_pieces(pieces_path, *model_pieces);
   outputs.push_back(pieces_path);
   const std::string preview_path = (dir / "preview.png").string();
-  write_pieces_preview(preview_path, topology.sliced);
+  if (polycube)
+    write_polycube_preview(preview_path, *polycube);
+  else
+    write_pieces_preview(preview_path, *model_pieces);
   outputs.push_back(preview_path);
 
-  report["seconds"] = {{"topology", topology.seconds_total}, {"total", progress.elapsed_seconds()}};
+  seconds["total"] = progress.elapsed_seconds();
+  report["seconds"] = seconds;
   const std::string report_path = (dir / "report.json").string();
   report["outputs"] = outputs;
   write_text_atomically(report_path, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
@@ -123,9 +197,13 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
   command->add_option("--dz", options->topology.dz, "Largest gap between cutting planes, unit-cube units (paper's d_z)")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));
-  command->add_option("--da", options->da, "Area tolerance of the axis-aligned contours (paper's d_a)")
+  command->add_option("--da", options->polycube.da, "Area tolerance of the axis-aligned contours (paper's d_a)")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));
+  command->add_option("--polycube-vertices", options->polycube.target_vertices,
+                      "About how many vertices the triangulated polycube gets (0: as many as the model)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   command->add_option("--stage", options->stage, "Stop after this stage")
       ->capture_default_str()
       ->check(CLI::IsMember(kStages));

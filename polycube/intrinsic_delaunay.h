@@ -27,6 +27,8 @@ struct IntrinsicDelaunayOptions {
 //                  F(f,(i+1)%3)
 //   adjacent_edge  #F by 3: the index of that same edge inside adjacent(f,i), so that
 //                  F(adjacent(f,i), adjacent_edge(f,i)) == F(f,(i+1)%3)
+//                  (surfaces with boundary, e.g. from flat_metric: both -1 across a boundary edge;
+//                  intrinsic_delaunay itself only takes closed meshes)
 //   length         #F by 3 intrinsic length of edge i of f, in the units of the input
 struct IntrinsicTriangulation {
   Eigen::MatrixX3i F;

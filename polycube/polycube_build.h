@@ -1,0 +1,106 @@
+// Stage 2 of the method (§3.2): the polycube P, built automatically from the model's cutting
+// planes with a topology guarantee — P cut by the same planes has pieces matching the model's
+// pieces one to one, with the same boundary loops and genus 0, so P has the model's genus and a
+// one-to-one map between them exists piece by piece (§3.3–3.4, Appendix).
+#pragma once
+
+#include "polycube/contour_sections.h"
+#include "polycube/mesh.h"
+#include "polycube/polycube_surface.h"
+#include "polycube/slice.h"
+#include "polycube/topology.h"
+
+#include <string>
+#include <vector>
+
+namespace polycube {
+
+struct PolycubeOptions {
+  // Largest normalised area difference area(Q_r Δ R_r) / area(R_r) of every region r of a cross
+  // section and its axis-aligned approximation (§3.2's d_a; §3.2's d_z is TopologyOptions::dz).
+  double da = 0.3;
+  // Deepest quadtree level the d_a refinement goes to (cells of 2^-level of the largest
+  // bounding-box side).
+  int max_level = 10;
+  // Deepest quadtree level topology repairs may subdivide to (at most kQuadGridBits = 20).
+  int max_repair_level = 18;
+  // About how many vertices P's mesh gets; 0: as many as the model has.
+  int target_vertices = 0;
+  // Per slab, how many times the quadtree cells along a failing slab's contours may be subdivided
+  // (only while the finely sampled contours pass the slab's check, i.e. subdivision can repair
+  // it) before a plane is inserted in the middle of the slab instead.
+  int refine_attempts = 4;
+  // Most quadtree leaves per plane: subdivisions for the stacking stop there (then planes are
+  // inserted instead), and a cross-section needing more for its own topology is an error.
+  int max_plane_cells = 40000;
+  // Planes the repairs may insert in total before giving up.
+  int max_inserted_planes = 400;
+  // Check-and-repair rounds before giving up.
+  int max_rounds = 80;
+  // Thinnest slab, as a fraction of the model's height, that may still get a plane inserted.
+  double min_slab = 1e-5;
+};
+
+// Everything the stage did.
+//   polycube          P in the input's coordinate frame
+//   model_sliced      the model cut by the final planes: its pieces M_j (the topology stage's
+//                     slicing when no plane was inserted)
+//   model_sections    the model's contours on the final planes
+//   polycube_sliced   P cut by the same planes: its pieces P_j
+//   polycube_piece_contours  per P piece: the model contours of its loops
+//   piece_match       per model piece M_j: the index of P_j (into polycube_sliced.pieces)
+//   planes_z          the final planes, input frame, ascending (= model_sliced.planes)
+//   genus             of the model and of P
+//   planes_inserted   planes the repairs inserted between existing ones
+//   accuracy_splits   quadtree subdivisions for d_a (§3.2)
+//   section_splits    subdivisions repairing the topology of single cross-sections (merged or
+//                     vanished contours, holes, diagonal touches)
+//   stacking_splits   subdivisions repairing slabs (non-manifold touches between extrusions,
+//                     pieces whose loops or genus did not match)
+//   relabelled_cells  cells grown into or shrunk out of a Q_i to remove non-manifold touches
+//   rounds            check-and-repair rounds (1 when nothing needed repair)
+//   deepest_level     of any quadtree leaf
+//   max_region_error  largest area(Q_r Δ R_r) / area(R_r) over all regions of all planes
+//   repairs           one line per repair made
+struct PolycubeResult {
+  Polycube polycube;
+  SlicedMesh model_sliced;
+  CrossSections model_sections;
+  SlicedMesh polycube_sliced;
+  std::vector<std::vector<int>> polycube_piece_contours;
+  std::vector<int> piece_match;
+  std::vector<double> planes_z;
+  int genus = 0;
+  int planes_inserted = 0;
+  int accuracy_splits = 0;
+  int section_splits = 0;
+  int stacking_splits = 0;
+  int relabelled_cells = 0;
+  int rounds = 0;
+  int deepest_level = 0;
+  double max_region_error = 0;
+  std::vector<std::string> repairs;
+  double seconds_quadtrees = 0;  // building and repairing the quadtrees
+  double seconds_checks = 0;     // slab checks and re-slicing
+  double seconds_surface = 0;    // faces, edges and triangulation of P
+  double seconds_verify = 0;     // final check of P
+  double seconds_total = 0;
+};
+
+// Builds the polycube of §3.2 for a model and its topology stage:
+//   1. contours of every plane and their nesting (cross_sections);
+//   2. per plane a quadtree approximation Q_i on a global dyadic grid, refined for d_a and for
+//      the topology of the contours (approximate_section);
+//   3. per slab between consecutive planes, a combinatorial check that the stacked extrusions
+//      are a 2-manifold and have the model's pieces (check_slab); failures are repaired by
+//      subdividing cells along the offending contours, then by inserting a plane in the middle
+//      of the slab and re-slicing the model;
+//   4. the surface, its faces, edges and corners, triangulated (build_polycube_surface);
+//   5. the guarantee checked on the triangle mesh (verify_polycube).
+//   model     the closed mesh the topology stage ran on (input frame)
+//   topology  analyse_topology(model, ...)
+// Throws AlgorithmError when the repairs exceed their limits or P fails its final check — an
+// invalid polycube is never returned — and std::invalid_argument for inconsistent inputs.
+PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topology, const PolycubeOptions& options = {});
+
+}  // namespace polycube

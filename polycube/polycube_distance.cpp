@@ -1,0 +1,88 @@
+#include "polycube/polycube_distance.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <tuple>
+#include <stdexcept>
+#include <vector>
+
+namespace polycube {
+
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using Point = Kernel::Point_3;
+using Triangle = Kernel::Triangle_3;
+using Iterator = std::vector<Triangle>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<Kernel, Iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+std::vector<Triangle> triangles_of(const TriMesh& mesh) {
+  std::vector<Triangle> triangles;
+  triangles.reserve(mesh.num_faces());
+  auto point = [&](int v) { return Point(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)); };
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    triangles.emplace_back(point(mesh.F(f, 0)), point(mesh.F(f, 1)), point(mesh.F(f, 2)));
+  return triangles;
+}
+
+// Vertices plus area-weighted random points of the surface.
+std::vector<Point> samples_of(const TriMesh& mesh, int count, unsigned seed) {
+  std::vector<Point> samples;
+  for (int v = 0; v < mesh.num_vertices(); ++v) samples.emplace_back(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2));
+  const Eigen::VectorXd area = face_areas(mesh);
+  std::vector<double> cumulative(area.size());
+  double total = 0;
+  for (Eigen::Index f = 0; f < area.size(); ++f) cumulative[f] = total += area[f];
+  if (!(total > 0)) return samples;
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (int k = 0; k < count; ++k) {
+    const double pick = uniform(random) * total;
+    const int f = static_cast<int>(std::min<size_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin(), cumulative.size() - 1));
+    double s = uniform(random), t = uniform(random);
+    if (s + t > 1) {
+      s = 1 - s;
+      t = 1 - t;
+    }
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d p = a + s * (b - a) + t * (c - a);
+    samples.emplace_back(p.x(), p.y(), p.z());
+  }
+  return samples;
+}
+
+// Largest and mean distance from the samples of `from` to the surface of `to`.
+std::pair<double, double> one_sided(const TriMesh& from, const TriMesh& to, const HausdorffOptions& options) {
+  const std::vector<Triangle> triangles = triangles_of(to);
+  Tree tree(triangles.begin(), triangles.end());
+  tree.accelerate_distance_queries();
+  double largest = 0, sum = 0;
+  const std::vector<Point> samples = samples_of(from, options.samples, options.seed);
+  for (const Point& p : samples) {
+    const double d = std::sqrt(tree.squared_distance(p));
+    largest = std::max(largest, d);
+    sum += d;
+  }
+  return {largest, samples.empty() ? 0.0 : sum / samples.size()};
+}
+
+}  // namespace
+
+HausdorffDistance hausdorff_distance(const TriMesh& a, const TriMesh& b, const HausdorffOptions& options) {
+  if (a.num_faces() == 0 || b.num_faces() == 0) throw std::invalid_argument("hausdorff_distance: empty mesh");
+  HausdorffDistance result;
+  std::tie(result.a_to_b, result.mean_a_to_b) = one_sided(a, b, options);
+  std::tie(result.b_to_a, result.mean_b_to_a) = one_sided(b, a, options);
+  result.hausdorff = std::max(result.a_to_b, result.b_to_a);
+  return result;
+}
+
+}  // namespace polycube

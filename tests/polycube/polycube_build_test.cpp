@@ -1,0 +1,324 @@
+// build_polycube: the polycube P is a closed, oriented, connected 2-manifold of the model's genus,
+// every triangle flat on an axis-aligned face with its normal exactly along the face's axis, and
+// P cut by the model's planes has pieces matching the model's one to one (same loops, genus 0) —
+// on generated surfaces of genus 0..4 and on the small test meshes. Smaller d_z / d_a give more
+// corners and a closer shape.
+#include "polycube/polycube_build.h"
+
+#include "polycube/errors.h"
+#include "polycube/mesh_topology.h"
+#include "polycube/polycube_distance.h"
+#include "polycube/topology.h"
+#include "support/generated_meshes.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace polycube {
+namespace {
+
+// Every property the issue lists, checked directly on the result.
+void expect_valid_polycube(const TopologyResult& topology, const PolycubeResult& result) {
+  const Polycube& P = result.polycube;
+  const TriMesh& mesh = P.mesh;
+  const int nv = mesh.num_vertices(), nf = mesh.num_faces();
+  ASSERT_GT(nf, 0);
+  ASSERT_EQ(P.face_axis.size(), nf);
+  ASSERT_EQ(P.face_patch.size(), nf);
+
+  // Closed (no T-junctions: they would leave edges with one triangle), 2-manifold, oriented.
+  const EdgeMap edges = build_edge_map(mesh.F);
+  int not_two = 0, misoriented = 0;
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    if (edges.face_count[e] != 2) {
+      ++not_two;
+      continue;
+    }
+    int forward = 0;
+    for (int k = 0; k < 2; ++k)
+      for (int i = 0; i < 3; ++i)
+        if (edges.FE(edges.EF(e, k), i) == e) forward += mesh.F(edges.EF(e, k), i) == edges.E(e, 0);
+    misoriented += forward != 1;
+  }
+  EXPECT_EQ(not_two, 0) << "edges without exactly two triangles";
+  EXPECT_EQ(misoriented, 0);
+  EXPECT_EQ(count_nonmanifold_vertices(mesh.F, nv), 0);
+  EXPECT_EQ(count_unreferenced_vertices(mesh.F, nv), 0);
+  EXPECT_EQ(connected_components(mesh.F, nv), 1);
+  EXPECT_EQ(genus(mesh.F, nv), topology.genus);
+  EXPECT_EQ(result.genus, topology.genus);
+  EXPECT_GT(signed_volume(mesh), 0) << "outward";
+
+  // Every triangle: positive area, normal exactly along its face's axis, with the face's sign;
+  // and in the plane of its polycube face.
+  int tilted = 0, degenerate = 0, off_face = 0;
+  for (int f = 0; f < nf; ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    const int axis = std::abs(P.face_axis[f]) - 1;
+    ASSERT_TRUE(axis >= 0 && axis < 3);
+    if (n[axis] == 0) ++degenerate;
+    if (n[(axis + 1) % 3] != 0 || n[(axis + 2) % 3] != 0 || (n[axis] > 0) != (P.face_axis[f] > 0)) ++tilted;
+    const PolycubeFace& face = P.faces[P.face_patch[f]];
+    if (face.axis != axis || a[axis] != face.coordinate || b[axis] != face.coordinate || c[axis] != face.coordinate)
+      ++off_face;
+  }
+  EXPECT_EQ(degenerate, 0);
+  EXPECT_EQ(tilted, 0);
+  EXPECT_EQ(off_face, 0);
+
+  // No vertex on a cutting plane (so slicing P leaves the planes where they are).
+  const std::set<double> planes(result.planes_z.begin(), result.planes_z.end());
+  for (int v = 0; v < nv; ++v) EXPECT_EQ(planes.count(mesh.V(v, 2)), 0u);
+
+  // Corners: polycube vertices where edges of all three directions meet; edges are straight.
+  std::map<int, std::array<int, 3>> directions;
+  for (const PolycubeEdge& edge : P.edges) {
+    ASSERT_GE(edge.vertices.size(), 2u);
+    for (size_t k = 0; k + 1 < edge.vertices.size(); ++k) {
+      const Eigen::Vector3d d = mesh.V.row(edge.vertices[k + 1]) - mesh.V.row(edge.vertices[k]);
+      EXPECT_EQ(d[(edge.axis + 1) % 3], 0);
+      EXPECT_EQ(d[(edge.axis + 2) % 3], 0);
+      EXPECT_NE(d[edge.axis], 0);
+    }
+    EXPECT_NE(edge.faces[0], edge.faces[1]);
+    directions[edge.vertices.front()][edge.axis] = 1;
+    directions[edge.vertices.back()][edge.axis] = 1;
+  }
+  int three = 0;
+  for (const auto& [v, d] : directions) three += d[0] && d[1] && d[2];
+  EXPECT_EQ(three, static_cast<int>(P.corners.size()));
+  for (int v : P.corners) EXPECT_TRUE(directions.count(v) && directions[v][0] && directions[v][1] && directions[v][2]);
+  EXPECT_GE(P.corners.size(), 8u);
+  EXPECT_TRUE(std::includes(P.vertices.begin(), P.vertices.end(), P.corners.begin(), P.corners.end()));
+
+  // Every contour of the model has exactly one loop of Q on its plane.
+  const CrossSections& sections = result.model_sections;
+  std::vector<int> loops(sections.contours.size(), 0);
+  ASSERT_EQ(P.sections.size(), sections.planes.size());
+  for (size_t i = 0; i < P.sections.size(); ++i)
+    for (const SectionPolygon& polygon : P.sections[i]) {
+      ASSERT_GE(polygon.contour, 0);
+      EXPECT_EQ(sections.contours[polygon.contour].plane, static_cast<int>(i));
+      ++loops[polygon.contour];
+    }
+  for (size_t c = 0; c < loops.size(); ++c) EXPECT_EQ(loops[c], 1) << "contour " << c;
+
+  // Pieces: one to one, same loops, genus 0.
+  const auto& model_pieces = result.model_sliced.pieces;
+  ASSERT_EQ(result.piece_match.size(), model_pieces.size());
+  EXPECT_EQ(result.polycube_sliced.pieces.size(), model_pieces.size());
+  EXPECT_EQ(result.polycube_sliced.planes, result.model_sliced.planes);
+  std::set<int> used;
+  for (size_t m = 0; m < model_pieces.size(); ++m) {
+    const int p = result.piece_match[m];
+    ASSERT_GE(p, 0) << "model piece " << m;
+    EXPECT_TRUE(used.insert(p).second);
+    EXPECT_EQ(result.polycube_sliced.pieces[p].genus, 0);
+    EXPECT_EQ(model_pieces[m].genus, 0);
+    std::vector<int> a = sections.piece_contours[m], b = result.polycube_piece_contours[p];
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b) << "loops of model piece " << m;
+    EXPECT_EQ(result.polycube_sliced.pieces[p].plane_below, model_pieces[m].plane_below);
+  }
+}
+
+PolycubeResult build(const TriMesh& mesh, const TopologyResult& topology, const PolycubeOptions& options = {}) {
+  return build_polycube(mesh, topology, options);
+}
+
+TEST(Polycube, GeneratedSurfacesOfGenus0To4) {
+  for (int g = 0; g <= 4; ++g) {
+    SCOPED_TRACE("genus " + std::to_string(g));
+    const TriMesh mesh = test::make_genus_surface(g, 24);
+    const TopologyResult topology = analyse_topology(mesh);
+    ASSERT_EQ(topology.genus, g);
+    const PolycubeResult result = build(mesh, topology);
+    expect_valid_polycube(topology, result);
+  }
+}
+
+TEST(Polycube, SmallTestMeshes) {
+  for (const auto& [name, g] : test::closed_test_meshes()) {
+    SCOPED_TRACE(name);
+    const TriMesh mesh = test::load_test_mesh(name);
+    const TopologyResult topology = analyse_topology(mesh);
+    const PolycubeResult result = build(mesh, topology);
+    EXPECT_EQ(result.genus, g);
+    expect_valid_polycube(topology, result);
+  }
+}
+
+// A tilted torus: its cross-sections move sideways from plane to plane, so extrusions of
+// neighbouring planes touch or miss each other unless the repairs step in.
+TEST(Polycube, TiltedTorusNeedsAndGetsRepairs) {
+  TriMesh mesh = test::make_torus(1.0, 0.3, 48, 24);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
+  mesh.V = (mesh.V * R.transpose()).eval();
+  const TopologyResult topology = analyse_topology(mesh);
+  const PolycubeResult result = build(mesh, topology);
+  expect_valid_polycube(topology, result);
+}
+
+TEST(Polycube, BoxModelGivesTheBox) {
+  // A unit cube with each side split into 6 x 6 quads: every cross-section is the whole unit
+  // square, so P is the cube itself: 8 corners, 6 faces, 12 edges.
+  const int n = 6;
+  TriMesh cube;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::array<int, 3>> triangles;
+  std::map<std::array<int, 3>, int> index;
+  auto vertex = [&](std::array<int, 3> p) {
+    auto it = index.find(p);
+    if (it != index.end()) return it->second;
+    points.emplace_back(p[0] / double(n), p[1] / double(n), p[2] / double(n));
+    return index[p] = static_cast<int>(points.size()) - 1;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int side = 0; side < 2; ++side)
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          std::array<int, 3> q[4];
+          const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+          const int corners[4][2] = {{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j + 1}};
+          for (int k = 0; k < 4; ++k) {
+            q[k][axis] = side * n;
+            q[k][u] = corners[k][0];
+            q[k][v] = corners[k][1];
+          }
+          int a = vertex(q[0]), b = vertex(q[1]), c = vertex(q[2]), d = vertex(q[3]);
+          if (side == 0) std::swap(b, d);
+          triangles.push_back({a, b, c});
+          triangles.push_back({a, c, d});
+        }
+  cube.V.resize(points.size(), 3);
+  for (size_t k = 0; k < points.size(); ++k) cube.V.row(k) = points[k].transpose();
+  cube.F.resize(triangles.size(), 3);
+  for (size_t k = 0; k < triangles.size(); ++k) cube.F.row(k) << triangles[k][0], triangles[k][1], triangles[k][2];
+  ASSERT_GT(signed_volume(cube), 0);
+
+  const TopologyResult topology = analyse_topology(cube);
+  const PolycubeResult result = build(cube, topology);
+  expect_valid_polycube(topology, result);
+  EXPECT_EQ(result.polycube.corners.size(), 8u);
+  EXPECT_EQ(result.polycube.faces.size(), 6u);
+  EXPECT_EQ(result.polycube.edges.size(), 12u);
+  EXPECT_NEAR(signed_volume(result.polycube.mesh), 1.0, 1e-12);
+  EXPECT_LT(hausdorff_distance(cube, result.polycube.mesh).hausdorff, 1e-9);
+}
+
+TEST(Polycube, SmallerDzAndDaGiveMoreCornersAndACloserShape) {
+  const TriMesh mesh = test::make_genus_surface(1, 32);
+  const double diagonal = bounding_box(mesh.V).diagonal();
+  struct Run {
+    double dz, da;
+    size_t corners = 0;
+    double distance = 0;
+  };
+  std::vector<Run> runs = {{0.3, 0.6}, {0.08, 0.3}, {0.03, 0.1}};
+  for (Run& run : runs) {
+    TopologyOptions topology_options;
+    topology_options.dz = run.dz;
+    const TopologyResult topology = analyse_topology(mesh, topology_options);
+    PolycubeOptions options;
+    options.da = run.da;
+    const PolycubeResult result = build(mesh, topology, options);
+    expect_valid_polycube(topology, result);
+    run.corners = result.polycube.corners.size();
+    run.distance = hausdorff_distance(mesh, result.polycube.mesh).hausdorff / diagonal;
+  }
+  for (size_t k = 1; k < runs.size(); ++k) {
+    EXPECT_GT(runs[k].corners, runs[k - 1].corners) << "run " << k;
+    EXPECT_LT(runs[k].distance, runs[k - 1].distance) << "run " << k;
+  }
+}
+
+TEST(Polycube, SmallerDaAloneGivesACloserShape) {
+  const TriMesh mesh = test::make_genus_surface(0, 32);
+  const TopologyResult topology = analyse_topology(mesh);
+  double previous = 1e300;
+  size_t previous_corners = 0;
+  for (double da : {0.5, 0.2, 0.05}) {
+    PolycubeOptions options;
+    options.da = da;
+    const PolycubeResult result = build(mesh, topology, options);
+    EXPECT_LE(result.max_region_error, da + 1e-12);
+    const double distance = hausdorff_distance(mesh, result.polycube.mesh).hausdorff;
+    EXPECT_LT(distance, previous) << "da " << da;
+    EXPECT_GT(result.polycube.corners.size(), previous_corners) << "da " << da;
+    previous = distance;
+    previous_corners = result.polycube.corners.size();
+  }
+}
+
+TEST(Polycube, TargetVertexCountSetsTheResolution) {
+  const TriMesh mesh = test::make_sphere(3);
+  const TopologyResult topology = analyse_topology(mesh);
+  const PolycubeResult like_model = build(mesh, topology);
+  EXPECT_GT(like_model.polycube.mesh.num_vertices(), mesh.num_vertices() / 2);
+  EXPECT_LT(like_model.polycube.mesh.num_vertices(), mesh.num_vertices() * 2);
+  for (int target : {500, 4000, 20000}) {
+    PolycubeOptions options;
+    options.target_vertices = target;
+    const PolycubeResult result = build(mesh, topology, options);
+    expect_valid_polycube(topology, result);
+    EXPECT_GT(result.polycube.mesh.num_vertices(), target / 2) << target;
+    EXPECT_LT(result.polycube.mesh.num_vertices(), target * 2) << target;
+  }
+}
+
+TEST(Polycube, ResultDoesNotDependOnScaleOrPosition) {
+  const TriMesh mesh = test::make_genus_surface(2, 24);
+  const PolycubeResult reference = build(mesh, analyse_topology(mesh));
+  for (double scale : {1e-4, 1e4}) {
+    TriMesh moved = mesh;
+    moved.V = ((mesh.V * scale).rowwise() + Eigen::RowVector3d(3, -7, 11) * scale).eval();
+    const TopologyResult topology = analyse_topology(moved);
+    const PolycubeResult result = build(moved, topology);
+    expect_valid_polycube(topology, result);
+    EXPECT_EQ(result.polycube.corners.size(), reference.polycube.corners.size()) << scale;
+    EXPECT_EQ(result.polycube.faces.size(), reference.polycube.faces.size()) << scale;
+  }
+}
+
+TEST(Polycube, RejectsBadOptions) {
+  const TriMesh mesh = test::make_sphere(2);
+  const TopologyResult topology = analyse_topology(mesh);
+  PolycubeOptions options;
+  options.da = 0;
+  EXPECT_THROW(build(mesh, topology, options), std::invalid_argument);
+  TopologyResult empty;
+  EXPECT_THROW(build(mesh, empty), std::invalid_argument);
+}
+
+TEST(Polycube, GivesUpWithAClearErrorWithinItsLimits) {
+  // A tilted torus needs repairs; forbidding them all must fail with AlgorithmError, never
+  // return an invalid polycube.
+  TriMesh mesh = test::make_torus(1.0, 0.15, 64, 24);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  mesh.V = (mesh.V * R.transpose()).eval();
+  TopologyOptions coarse;
+  coarse.dz = 0.4;
+  const TopologyResult topology = analyse_topology(mesh, coarse);
+  PolycubeOptions options;
+  options.max_rounds = 1;
+  try {
+    const PolycubeResult result = build(mesh, topology, options);
+    expect_valid_polycube(topology, result);  // needed no repair at all: still valid
+  } catch (const AlgorithmError& e) {
+    EXPECT_NE(std::string(e.what()).find("build_polycube"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace polycube
