@@ -1,6 +1,7 @@
 // End-to-end: `polycube map` through the real binary: outputs, report, and clean failures.
 #include "formats/image_io.h"
 #include "formats/mesh_io.h"
+#include "polycube/validate.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -48,6 +49,28 @@ TEST(MapCli, TopologyStageWritesReportAndPieces) {
 
   for (const auto& entry : std::filesystem::directory_iterator(dir))
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << "no temporary left behind";
+}
+
+TEST(MapCli, PolycubeStageWritesAValidAxisAlignedPolycubeOfTheSameGenus) {
+  const std::string dir = test::temp_dir("map-polycube");
+  const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("rotor.off")) + " -o " + quoted(dir) +
+                                  " --stage polycube");
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  const PreparedMesh cube = prepare_mesh(read_polygon_soup(dir + "/polycube.obj"));
+  EXPECT_TRUE(cube.diagnosis.valid()) << (cube.diagnosis.problems.empty() ? "" : cube.diagnosis.problems[0]);
+  EXPECT_TRUE(cube.repairs.empty()) << "written as a clean, outward-oriented mesh: " << cube.repairs.front();
+  EXPECT_EQ(cube.diagnosis.genus, 1);
+  EXPECT_EQ(report.at("polycube").at("genus").get<int>(), 1);
+  EXPECT_EQ(report.at("polycube").at("vertices").get<int>(), cube.mesh.num_vertices());
+  EXPECT_GT(report.at("polycube").at("corners").get<int>(), 8);
+  const Eigen::MatrixX3d normals = face_normals(cube.mesh);
+  for (int f = 0; f < cube.mesh.num_faces(); ++f) {
+    const Eigen::Vector3d n = normals.row(f).cwiseAbs();
+    EXPECT_DOUBLE_EQ(n.maxCoeff(), 1.0) << "face " << f << " is not axis-aligned";
+  }
+  EXPECT_GT(signed_volume(cube.mesh), 0);
+  EXPECT_NO_THROW(read_image(dir + "/preview.png"));
 }
 
 TEST(MapCli, QuietRunPrintsNothing) {
