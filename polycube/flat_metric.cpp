@@ -435,7 +435,7 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
   Eigen::VectorXd u = Eigen::VectorXd::Zero(nv);
   if (options.initial_delaunay)
     result.initial_flips = static_cast<int>(ricci::make_delaunay(m, u, true, options.delaunay_tolerance, max_flips));
-  const int max_inserted = std::max(options.max_inserted_vertices, 0);
+  const int max_inserted = options.max_inserted_vertices >= 0 ? options.max_inserted_vertices : boundary_halfedges + 16;
 
   // Splits the boundary edge of halfedge h at its midpoint in the metric at u and records it.
   auto split_boundary_edge = [&](int h) {
@@ -508,9 +508,13 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
     throw MeshError("flat_metric: a boundary loop is degenerate (its longest edge is as long as the rest)");
 
   const bool balance = options.balance;
-  double penalty = 1;  // of the merit function E + penalty |balance|_1
+  double penalty = 1;
+  double radius = options.max_step;  // trust region for the largest change of u in one step
+  bool capped = false;
+  Eigen::Vector2d multiplier = Eigen::Vector2d::Zero();
   auto merit = [&](const Evaluation& e) {
-    return e.energy + (balance ? penalty * (std::abs(e.balance.real()) + std::abs(e.balance.imag())) : 0.0);
+    const Eigen::Vector2d C(e.balance.real(), e.balance.imag());
+    return e.energy + (balance ? multiplier.dot(C) + 0.5 * penalty * C.squaredNorm() : 0.0);
   };
   auto converged = [&](const Evaluation& e) {
     return e.residual <= options.tolerance && (!balance || std::abs(e.balance) <= options.balance_tolerance);
@@ -548,39 +552,46 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
       }
       // Newton (KKT) direction with the full Hessian; if it fails or gives no descent, with its
       // convex part (the outer loop's term is concave, so H can be indefinite far from the
-      // solution); as the last resort steepest descent.
+      // solution); as the last resort steepest descent. Trust region: the step is scaled so that
+      // no u changes by more than max_step, so a badly predicted direction cannot jump far.
+      // Merit function: the augmented Lagrangian E + nu . C + penalty / 2 |C|^2 of the balance
+      // constraint C, with the step's multiplier nu.
       const double damping = options.damping * std::max(ev.residual, 1e-8) / nvt;
+      const Eigen::Vector2d C(ev.balance.real(), ev.balance.imag());
       Eigen::VectorXd delta;
       double slope = 0;
-      Eigen::Vector2d multiplier = Eigen::Vector2d::Zero();
-      for (int attempt = 0; attempt < 2; ++attempt) {
+      multiplier.setZero();
+      for (int attempt = 0; attempt < 3; ++attempt) {
         Eigen::MatrixXd x;
-        if (attempt == 1) ++result.fallback_steps;
-        if (!system.factor(m, ev, loops, attempt == 0, damping) || !system.solve(rhs, x)) continue;
-        delta = x.col(0);
-        if (balance) {
-          // H delta + C^T nu = -g, C delta = -balance: delta = z - Y nu with
-          // (C Y) nu = C z + balance.
-          Eigen::Matrix2d CY;
-          CY << c_re.dot(x.col(1)), c_re.dot(x.col(2)), c_im.dot(x.col(1)), c_im.dot(x.col(2));
-          const Eigen::Vector2d r(c_re.dot(delta) + ev.balance.real(), c_im.dot(delta) + ev.balance.imag());
-          multiplier = CY.fullPivLu().solve(r);
-          if (!multiplier.allFinite()) continue;
-          delta -= x.col(1) * multiplier[0] + x.col(2) * multiplier[1];
+        if (attempt < 2) {
+          if (attempt == 1) ++result.fallback_steps;
+          if (!system.factor(m, ev, loops, attempt == 0, damping) || !system.solve(rhs, x)) continue;
+          delta = x.col(0);
+          if (balance) {
+            // H delta + C_u^T nu = -g, C_u delta = -C: delta = z - Y nu, (C_u Y) nu = C_u z + C.
+            Eigen::Matrix2d CY;
+            CY << c_re.dot(x.col(1)), c_re.dot(x.col(2)), c_im.dot(x.col(1)), c_im.dot(x.col(2));
+            multiplier = CY.fullPivLu().solve(Eigen::Vector2d(c_re.dot(delta) + C.x(), c_im.dot(delta) + C.y()));
+            if (!multiplier.allFinite()) continue;
+            delta -= x.col(1) * multiplier[0] + x.col(2) * multiplier[1];
+          }
+        } else {
+          delta = rhs.col(0);
+          multiplier.setZero();
         }
-        slope = -rhs.col(0).dot(delta);
-        if (balance) {
-          penalty = std::max(penalty, 2 * multiplier.cwiseAbs().maxCoeff());
-          slope -= penalty * (std::abs(ev.balance.real()) + std::abs(ev.balance.imag()));
-        }
+        if (!delta.allFinite()) continue;
+        const double largest = delta.cwiseAbs().maxCoeff();
+        capped = largest > radius;
+        if (capped) delta *= radius / largest;
+        // Descent needs the Lagrangian part to decrease (H positive on the step); the penalty
+        // part then does too, as the step reduces C.
+        const double gd = -rhs.col(0).dot(delta);
+        const Eigen::Vector2d Cd(c_re.dot(delta), c_im.dot(delta));
+        const double lagrangian = gd + (balance ? multiplier.dot(Cd) : 0.0);
+        slope = lagrangian + (balance ? penalty * C.dot(Cd) : 0.0);
         // Near the solution (quadratic convergence) the slope is lost in rounding; the line
         // search then accepts a full step that shrinks the residual.
-        if (delta.allFinite() && (slope < 0 || (attempt == 0 && ev.residual < 1e-6))) break;
-        delta.resize(0);
-      }
-      if (delta.size() == 0) {
-        delta = rhs.col(0);
-        slope = -delta.squaredNorm();
+        if ((lagrangian < 0 && slope < 0) || (attempt == 0 && ev.residual < 1e-6)) break;
       }
       for (int v = 0; v < nvt; ++v) delta_full[v] = index[v] >= 0 ? delta[index[v]] : 0.0;
 
@@ -598,7 +609,11 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
         if (options.delaunay_flips) ricci::make_delaunay(m, u_trial, false, options.delaunay_tolerance, max_flips);
         evaluate(m, u_trial, loops, outer, trial);
         const bool more_invalid = trial.invalid_triangles > ev.invalid_triangles;
-        if (trial.valid && !(options.reject_invalid && more_invalid)) {
+        // The balance may not grow beyond max(current, balance_slack): far from the solution
+        // the energy can keep decreasing towards a crowded outer loop, which only the
+        // constraint stops.
+        const bool balanced = !balance || std::abs(trial.balance) <= std::max(std::abs(ev.balance), options.balance_slack);
+        if (trial.valid && balanced && !(options.reject_invalid && more_invalid)) {
           const double rounding = 1e-13 * std::max(ev.energy_scale, trial.energy_scale);
           const bool armijo = merit(trial) <= merit0 + 1e-4 * t * slope + rounding;
           const bool near = t == 1 && ev.residual < 1e-6 && trial.residual < 0.5 * ev.residual &&
@@ -612,6 +627,10 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
         ++result.line_search_halvings;
         t *= 0.5;
       }
+      // The trust region grows while capped steps are taken in full and shrinks back when the
+      // line search has to cut.
+      if (accepted && t == 1 && capped) radius = std::min(2 * radius, 64 * options.max_step);
+      if (t < 1) radius = std::max(options.max_step, 0.5 * radius);
       if (accepted) {
         u.swap(u_trial);
         std::swap(ev, trial);
@@ -621,13 +640,15 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
         if (options.delaunay_flips) ricci::make_delaunay(m, u, false, options.delaunay_tolerance, max_flips);
         evaluate(m, u, loops, outer, ev);
       }
-      if (!too_long.empty() && t < options.split_step) return {"", too_long};
-      if (!accepted)
-        return {"line search stalled after " + std::to_string(result.iterations) + " Newton iterations", {}};
+      const std::string stalled =
+          accepted ? std::string() : "line search stalled after " + std::to_string(result.iterations) + " Newton iterations";
+      if (!too_long.empty() && t < options.split_step) return {stalled, too_long};
+      if (!accepted) return {stalled, {}};
     }
   };
 
-  // Newton, splitting boundary edges where the line search asks for it.
+  // Newton, splitting boundary edges where the line search asks for it. Ends: each round either
+  // inserts a vertex (at most max_inserted), takes a step (at most max_iterations) or fails.
   std::string failure;
   while (true) {
     Outcome outcome = newton();
@@ -637,6 +658,7 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
     for (int h : outcome.split)
       if (static_cast<int>(result.inserted_vertices.size()) < max_inserted && split_boundary_edge(h)) any = true;
     if (any) {
+      failure.clear();
       if (options.delaunay_flips) ricci::make_delaunay(m, u, false, options.delaunay_tolerance, max_flips);
       reindex();
       evaluate(m, u, loops, outer, ev);

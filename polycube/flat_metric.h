@@ -7,10 +7,10 @@
 // Method. The paper's Ricci flow du/dt = K̄ − K (eq. 2) is the gradient flow of a convex energy;
 // this goes straight to its fixed point: vertex scaling l_ij = e^{(u_i+u_j)/2} l⁰_ij, the energy
 // of Springborn–Schröder–Pinkall ("Conformal equivalence of triangle meshes", 2008) minimised
-// by Newton's method with backtracking line search, the triangulation kept intrinsic Delaunay
-// by Ptolemy flips at every evaluated u (Gillespie–Springborn–Crane, "Discrete conformal
-// equivalence of polyhedral surfaces", 2021), which keeps the energy C¹ and every interior
-// triangle valid for any u. The Hessian (cotangent Laplacian plus the loops' terms, below) is
+// by Newton's method with a trust region and backtracking line search, the triangulation kept
+// intrinsic Delaunay by Ptolemy flips at every evaluated u (Gillespie–Springborn–Crane,
+// "Discrete conformal equivalence of polyhedral surfaces", 2021), which keeps the energy C¹ and
+// every interior triangle valid for any u. The Hessian (cotangent Laplacian plus the loops' terms, below) is
 // factored by sparse LDLᵀ, its pattern analysed once per connectivity.
 //
 // Constant geodesic curvature. A loop's target turning angles are those of the polygon
@@ -48,8 +48,9 @@ struct FlatMetricOptions {
   // Converged when every vertex's angle sum is within this many radians of its target (interior
   // 2π, boundary π − target geodesic curvature), i.e. max |curvature error| <= tolerance.
   double tolerance = 1e-10;
-  // Newton iterations before giving up with AlgorithmError (typical: 4–15).
-  int max_iterations = 100;
+  // Newton iterations before giving up with AlgorithmError (typical: 4–20; up to ~80 on small
+  // pieces with clusters of tiny boundary edges, where flips keep changing the Hessian).
+  int max_iterations = 200;
   // Keep the triangulation intrinsic Delaunay by Ptolemy flips during the solve (recommended:
   // the energy stays convex in the interior and every interior triangle stays valid). false keeps
   // the starting connectivity; then invalid triangles are handled only by the line search.
@@ -75,8 +76,14 @@ struct FlatMetricOptions {
   // A boundary edge that is too long in a triangle rejected by the line search is split (in the
   // current metric) when the accepted step is shorter than this fraction of the Newton step.
   double split_step = 1.0 / 8;
-  // Most vertices inserted by splits, over the whole solve.
-  int max_inserted_vertices = 100000;
+  // Most vertices inserted by splits, over the whole solve; -1: the number of boundary edges
+  // plus 16 (then the solve goes on without splitting, and fails if it stalls).
+  int max_inserted_vertices = -1;
+  // Initial trust region: the largest change of any u in one Newton step (the step is scaled
+  // down to it), against steps into badly modelled regions, e.g. towards crowded outer loops.
+  // It doubles (up to 64 times this) while capped steps are accepted in full, and halves back
+  // (not below this) when the line search cuts a step.
+  double max_step = 1;
   // Halvings of the Newton step in one line search before giving up with AlgorithmError.
   int max_line_search_steps = 60;
   // Fix the Möbius freedom by the constraint FlatMetric::balance = 0, to balance_tolerance.
@@ -84,6 +91,9 @@ struct FlatMetricOptions {
   // (the layout then depends on rounding at the 1e-6 level, and can end up crowded).
   bool balance = true;
   double balance_tolerance = 1e-10;
+  // Line-search points where the balance exceeds max(its current value, balance_slack) are
+  // rejected: the energy alone can decrease towards a crowded outer loop.
+  double balance_slack = 0.1;
   // Index of the loop to map to the outer circle; -1: the longest loop by input length (§3.3).
   int outer_loop = -1;
   // false: return an unconverged result (converged = false) instead of throwing AlgorithmError.

@@ -1,5 +1,7 @@
 #include "polycube/harmonic_function.h"
 
+#include "polycube/triangle_geometry.h"
+
 #include "polycube/errors.h"
 #include "polycube/mesh_topology.h"
 
@@ -16,20 +18,8 @@ namespace polycube {
 
 namespace {
 
-double triangle_area(double a, double b, double c) {
-  if (a < b) std::swap(a, b);
-  if (a < c) std::swap(a, c);
-  if (b < c) std::swap(b, c);
-  const double p = (a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c));
-  return p > 0 ? 0.25 * std::sqrt(p) : 0.0;
-}
-
 // Half the cotangent of the angle opposite edge a (the triangle's share of the edge weight).
-double half_cotan_opposite(double a, double b, double c) {
-  const double area = triangle_area(a, b, c);
-  const double scale = a * a + b * b + c * c;
-  return 0.5 * (b * b + c * c - a * a) / std::max(4 * area, 1e-300 + 1e-16 * scale);
-}
+double half_cotan_opposite(double a, double b, double c) { return 0.5 * cotan_opposite(a, b, c); }
 
 // Lowest and highest vertex by z; ties go to the smallest index.
 void extreme_vertices(const Eigen::MatrixX3d& V, int& lowest, int& highest) {

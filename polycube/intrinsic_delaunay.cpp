@@ -1,5 +1,7 @@
 #include "polycube/intrinsic_delaunay.h"
 
+#include "polycube/triangle_geometry.h"
+
 #include "polycube/errors.h"
 #include "polycube/mesh_topology.h"
 
@@ -12,25 +14,6 @@
 namespace polycube {
 
 namespace {
-
-// Area of a triangle from its edge lengths (Kahan's stable form of Heron's formula); 0 when the
-// lengths violate the triangle inequality by rounding.
-double triangle_area(double a, double b, double c) {
-  if (a < b) std::swap(a, b);
-  if (a < c) std::swap(a, c);
-  if (b < c) std::swap(b, c);
-  const double p = (a + (b + c)) * (c - (a - b)) * (c + (a - b)) * (a + (b - c));
-  return p > 0 ? 0.25 * std::sqrt(p) : 0.0;
-}
-
-// Cotangent of the angle opposite edge `a` in the triangle with edge lengths a, b, c. Degenerate
-// triangles give large finite values with the right sign instead of infinities.
-double cotan_opposite(double a, double b, double c) {
-  const double area = triangle_area(a, b, c);
-  const double scale = a * a + b * b + c * c;
-  const double denominator = std::max(4 * area, 1e-300 + 1e-16 * scale);
-  return (b * b + c * c - a * a) / denominator;
-}
 
 // Halfedge structure with explicit next pointers, so that flips can move halfedges between faces.
 // Halfedge h runs from vert[h] to vert[next[h]].

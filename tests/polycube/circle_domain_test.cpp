@@ -26,29 +26,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Open tube around the z axis (n around, rows + 1 rings), outward-oriented.
-TriMesh tube(double radius, double height, int n, int rows) {
-  TriMesh m;
-  m.V.resize(n * (rows + 1), 3);
-  for (int j = 0; j <= rows; ++j)
-    for (int i = 0; i < n; ++i)
-      m.V.row(j * n + i) << radius * std::cos(2 * kPi * i / n), radius * std::sin(2 * kPi * i / n), height * j / rows;
-  m.F.resize(2 * n * rows, 3);
-  int f = 0;
-  for (int j = 0; j < rows; ++j)
-    for (int i = 0; i < n; ++i) {
-      const int a = j * n + i, b = j * n + (i + 1) % n, c = b + n, d = a + n;
-      if ((i + j) % 2 == 0) {
-        m.F.row(f++) << a, b, c;
-        m.F.row(f++) << a, c, d;
-      } else {
-        m.F.row(f++) << a, b, d;
-        m.F.row(f++) << b, c, d;
-      }
-    }
-  return m;
-}
-
 // Conformal modulus ln(R/r) of the annulus between the unit circle and an inner circle of radius
 // r centred at distance d (Möbius-invariant: the concentric annulus it is equivalent to).
 double annulus_modulus(double r, double d) { return std::acosh((1 + r * r - d * d) / (2 * r)); }
@@ -102,7 +79,7 @@ TEST(CircleDomain, TubeGivesAnAnnulusOfTheRightModulus) {
   for (double h : {0.25, 1.0}) {
     SCOPED_TRACE("height " + std::to_string(h));
     const int n = 96;
-    const TriMesh m = tube(1, h, n, static_cast<int>(std::round(h * n / (2 * kPi))) + 1);
+    const TriMesh m = test::make_tube(1, h, n, static_cast<int>(std::round(h * n / (2 * kPi))) + 1);
     const FlatMetric fm = flat_metric(m, boundary_loops(m.F));
     const CircleDomain cd = circle_domain(m, fm);
     expect_circle_domain(m, fm, cd);
@@ -121,7 +98,7 @@ TEST(CircleDomain, SliversStayEmbeddedInTheIntrinsicTriangulation) {
   // Slivers along both loops of a tube (apex over the middle of the loop edges, 1e-4 away):
   // drawn with straight edges some input triangles of the outer loop fall outside their chord,
   // the intrinsic triangulation (with the split outer edges) stays embedded.
-  TriMesh m = tube(1, 1, 40, 10);
+  TriMesh m = test::make_tube(1, 1, 40, 10);
   for (int j : {1, 9})
     for (int i = 0; i < 40; ++i) {
       const double angle = 2 * kPi * (i + 0.5) / 40;
@@ -205,7 +182,7 @@ TEST(CircleDomain, AllPiecesOfASlicedMeshOnThreads) {
 }
 
 TEST(CircleDomain, RejectsAMetricOfAnotherPiece) {
-  const TriMesh a = tube(1, 1, 12, 3), b = tube(1, 1, 16, 3);
+  const TriMesh a = test::make_tube(1, 1, 12, 3), b = test::make_tube(1, 1, 16, 3);
   EXPECT_THROW(circle_domain(b, flat_metric(a, boundary_loops(a.F))), std::invalid_argument);
 }
 

@@ -486,4 +486,26 @@ TriMesh flipped_face_tetrahedron() {
   return to_mesh(points, triangles);
 }
 
+TriMesh make_tube(double radius, double height, int n, int rows) {
+  TriMesh m;
+  m.V.resize(n * (rows + 1), 3);
+  for (int j = 0; j <= rows; ++j)
+    for (int i = 0; i < n; ++i)
+      m.V.row(j * n + i) << radius * std::cos(2 * kPi * i / n), radius * std::sin(2 * kPi * i / n), height * j / rows;
+  m.F.resize(2 * n * rows, 3);
+  int f = 0;
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * n + i, b = j * n + (i + 1) % n, c = b + n, d = a + n;
+      if ((i + j) % 2 == 0) {
+        m.F.row(f++) << a, b, c;
+        m.F.row(f++) << a, c, d;
+      } else {
+        m.F.row(f++) << a, b, d;
+        m.F.row(f++) << b, c, d;
+      }
+    }
+  return m;
+}
+
 }  // namespace polycube::test

@@ -37,6 +37,10 @@ TriMesh make_genus_surface(int genus, int resolution = 48);
 // Returns 10*4^s + 2 vertices and 20*4^s triangles.
 TriMesh make_sphere(int subdivisions);
 
+// Open tube around the z axis: n vertices around, rows + 1 rings from z = 0 to z = height,
+// quads split along alternating diagonals, outward-oriented; two boundary loops (genus 0).
+TriMesh make_tube(double radius, double height, int n, int rows);
+
 // ---- broken fixtures: each has exactly the defect its name says --------------------------------
 
 // Open tube (radius 1, height 2, 8 segments around, 2 rings of quads) without caps: one
