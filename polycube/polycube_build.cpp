@@ -20,8 +20,6 @@
 #include <memory>
 #include <set>
 #include <sstream>
-#include <cstdio>
-#include <cstdlib>
 #include <stdexcept>
 
 namespace polycube {
@@ -90,6 +88,7 @@ struct PlaneState {
   int version = 0;    // of the quadtree, unique over all planes and rebuilds
   QuadtreeSection quadtree;
   std::shared_ptr<std::vector<QuadLeaf>> sampled;  // the finely sampled section, when needed
+  bool sampled_faithful = false;                   // it has the contours' topology
 };
 
 // How badly a slab fails: non-manifold vertices, and far worse, unmatched model pieces.
@@ -207,8 +206,6 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
                                state.quadtree.problem);
       }
       leaves[i] = &state.quadtree.leaves;
-      if (getenv("CUBE_DEBUG") && state.quadtree.leaves.size() > 5000)
-        fprintf(stderr, "plane %d z %g: %zu leaves, acc %d forced %d topo %d deepest %d, %zu requested splits, %zu labels, %zu contours\n", i, sliced.planes[i], state.quadtree.leaves.size(), state.quadtree.accuracy_splits, state.quadtree.forced_splits, state.quadtree.topology_splits, state.quadtree.deepest_level, state.edits.splits.size(), state.edits.labels.size(), sections.planes[i].contours.size());
     }
     result.seconds_quadtrees += seconds_since(t);
     if (!unusable.empty()) {
@@ -234,6 +231,8 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
       }
       sliced = slice_mesh(surface, planes);
       result.seconds_checks += seconds_since(t);
+      if (round >= options.max_rounds)
+        throw AlgorithmError("build_polycube: still moving planes after " + std::to_string(round) + " rounds");
       continue;
     }
 
@@ -314,27 +313,26 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
       }
       if (repaired) continue;
 
-      // 2. Subdivide the cells along the failing contours when the contours themselves, sampled
-      //    finely, give the model's pieces (the quadtree lost what they have).
+      // 2. Subdivide the cells where the slab's regions meet when the contours themselves,
+      //    sampled finely, give the model's pieces (the quadtree lost what they have).
       const int attempts = ++slab_attempts[{s > 0 ? z_lo : below_all, s < n ? z_hi : above_all}];
       int requested = 0;
       if (attempts <= options.refine_attempts) {
+        // When the sampled sections themselves lack the contours' topology (a gap or neck
+        // finer than the samples), the reference says nothing: subdivide too.
         const std::vector<QuadLeaf>* sampled[2] = {nullptr, nullptr};
+        bool faithful = true;
         for (int side = 0; side < 2; ++side) {
           const int plane = side == 0 ? s - 1 : s;
           if (plane < 0 || plane >= n) continue;
           PlaneState& state = states[sliced.planes[plane]];
-          if (!state.sampled) state.sampled = std::make_shared<std::vector<QuadLeaf>>(sample_section(sections, plane));
+          if (!state.sampled) {
+            state.sampled = std::make_shared<std::vector<QuadLeaf>>(sample_section(sections, plane, 256));
+            std::vector<char> unused;
+            state.sampled_faithful = check_section_topology(sections.planes[plane], *state.sampled, unused).empty();
+          }
           sampled[side] = state.sampled.get();
-        }
-        // When the sampled sections themselves lack the contours' topology (a gap or neck
-        // finer than the samples), the reference says nothing: subdivide too.
-        bool faithful = true;
-        for (int side = 0; side < 2; ++side) {
-          const int plane = side == 0 ? s - 1 : s;
-          std::vector<char> unused;
-          if (sampled[side] && !check_section_topology(sections.planes[plane], *sampled[side], unused).empty())
-            faithful = false;
+          faithful = faithful && state.sampled_faithful;
         }
         const SlabCheck reference = check(s, sampled[0], sampled[1]);
         const bool repairable = !faithful || std::find(reference.model_match.begin(), reference.model_match.end(), -1) ==
@@ -367,7 +365,6 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
       const double z = place_plane(heights, 0.5 * (z_lo + z_hi), z_lo, z_hi, 0.25 * (z_hi - z_lo));
       inserted.push_back(z);
       result.repairs.push_back(where.str() + "; inserted a plane at z = " + std::to_string(z));
-      if (getenv("CUBE_DEBUG")) fprintf(stderr, "%s\n", result.repairs.back().c_str());
     }
     result.seconds_checks += seconds_since(t);
     if (failing == 0) break;
@@ -393,6 +390,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
     if (!std::binary_search(sliced.planes.begin(), sliced.planes.end(), z)) continue;
     result.accuracy_splits += state.quadtree.accuracy_splits;
     result.section_splits += state.quadtree.topology_splits;
+    result.section_relabels += state.quadtree.topology_relabels;
     result.deepest_level = std::max(result.deepest_level, state.quadtree.deepest_level);
     for (double e : state.quadtree.region_error) result.max_region_error = std::max(result.max_region_error, e);
   }

@@ -26,10 +26,11 @@ struct PolycubeOptions {
   int max_repair_level = 18;
   // About how many vertices P's mesh gets; 0: as many as the model has.
   int target_vertices = 0;
-  // Per slab, how many times the quadtree cells along a failing slab's contours may be subdivided
-  // (only while the finely sampled contours pass the slab's check, i.e. subdivision can repair
-  // it) before a plane is inserted in the middle of the slab instead.
-  int refine_attempts = 4;
+  // Per slab, how many times the quadtree cells where a failing slab's regions meet may be
+  // subdivided (only when the finely sampled contours pass the slab's check, i.e. subdivision
+  // can repair it) before a plane is inserted in the middle of the slab instead. More attempts
+  // trade planes for (many) corners.
+  int refine_attempts = 1;
   // Most quadtree leaves per plane: subdivisions for the stacking stop there (then planes are
   // inserted instead), and a cross-section needing more for its own topology is an error.
   int max_plane_cells = 40000;
@@ -55,6 +56,8 @@ struct PolycubeOptions {
 //   accuracy_splits   quadtree subdivisions for d_a (§3.2)
 //   section_splits    subdivisions repairing the topology of single cross-sections (merged or
 //                     vanished contours, holes, diagonal touches)
+//   section_relabels  cells relabelled where a cross-section's topology needed cells finer than
+//                     max_repair_level (slivers, near-touching contours)
 //   stacking_splits   subdivisions repairing slabs (non-manifold touches between extrusions,
 //                     pieces whose loops or genus did not match)
 //   relabelled_cells  cells grown into or shrunk out of a Q_i to remove non-manifold touches
@@ -74,6 +77,7 @@ struct PolycubeResult {
   int planes_inserted = 0;
   int accuracy_splits = 0;
   int section_splits = 0;
+  int section_relabels = 0;
   int stacking_splits = 0;
   int relabelled_cells = 0;
   int rounds = 0;
@@ -92,9 +96,13 @@ struct PolycubeResult {
 //   2. per plane a quadtree approximation Q_i on a global dyadic grid, refined for d_a and for
 //      the topology of the contours (approximate_section);
 //   3. per slab between consecutive planes, a combinatorial check that the stacked extrusions
-//      are a 2-manifold and have the model's pieces (check_slab); failures are repaired by
-//      subdividing cells along the offending contours, then by inserting a plane in the middle
-//      of the slab and re-slicing the model;
+//      are a 2-manifold and have the model's pieces (check_slab). Failures are repaired locally,
+//      in this order: non-manifold touches by growing or shrinking the cells around them so
+//      that the two cross-sections nest there (kept only if neither slab of the plane gets
+//      worse); then, if the contours sampled finely would pass (sample_section), by subdividing
+//      the cells where the slab's regions meet; otherwise by inserting a plane in the middle of
+//      the slab and re-slicing the model. Inserted planes whose cross-section cannot be
+//      approximated (a neck finer than the deepest cells) are moved within their slab;
 //   4. the surface, its faces, edges and corners, triangulated (build_polycube_surface);
 //   5. the guarantee checked on the triangle mesh (verify_polycube).
 //   model     the closed mesh the topology stage ran on (input frame)

@@ -7,8 +7,6 @@
 #include <map>
 #include <numeric>
 #include <sstream>
-#include <cstdio>
-#include <cstdlib>
 
 namespace polycube {
 
@@ -99,7 +97,6 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
   }
   const QuadRaster raster = rasterize({side_leaves[0], side_leaves[1]});
   const int nx = raster.nx(), ny = raster.ny();
-  if (getenv("CUBE_DEBUG")) fprintf(stderr, "check_slab raster %d x %d (%zu / %zu leaves)\n", nx, ny, side_leaves[0]->size(), side_leaves[1]->size());
   auto face = [&](int s, int cx, int cy) {
     const int l = raster.leaf_at(s, cx, cy);
     return l < 0 ? 0 : (*side_leaves[s])[l].face;

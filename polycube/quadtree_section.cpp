@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
 #include <sstream>
 
 namespace polycube {
@@ -137,7 +136,7 @@ class Builder {
   int split_down_to(const QuadCell& cell) {
     int splits = 0, n = 0;
     while (true) {
-      const QuadCell& c = nodes_[n].cell;
+      const QuadCell c = nodes_[n].cell;
       if (c.level > cell.level) break;
       if (nodes_[n].first_child < 0) {
         split(n);
@@ -313,7 +312,7 @@ QuadtreeSection approximate_section(const CrossSections& sections, int plane, co
   std::vector<int> leaf_nodes;
   const size_t leaf_budget = std::max<size_t>(builder.leaves().size(), options.max_leaves);
   bool labelled = edits.labels.empty();
-  for (int round = 0, rounds_after_labels = 0;; ++round) {
+  for (int round = 0, rounds_after_labels = 0, relabel_rounds = 0;; ++round) {
     leaf_nodes = builder.leaves();
     leaves.clear();
     for (int n : leaf_nodes) leaves.push_back(leaf_of(builder.node(n)));
@@ -336,8 +335,22 @@ QuadtreeSection approximate_section(const CrossSections& sections, int plane, co
       if (mark[l] && leaves[l].mixed && !builder.node(leaf_nodes[l]).imposed && leaves[l].cell.level < max_repair_level)
         to_split.push_back(leaf_nodes[l]);
     if (labelled && !edits.labels.empty()) ++rounds_after_labels;
-    if (to_split.empty() || round >= options.max_repair_rounds || rounds_after_labels > 4 ||
-        leaves.size() + 3 * to_split.size() > leaf_budget) {
+    const bool stalled = to_split.empty() || round >= options.max_repair_rounds || rounds_after_labels > 4 ||
+                         leaves.size() + 3 * to_split.size() > leaf_budget;
+    if (stalled && relabel_rounds < 8 && edits.labels.empty()) {
+      // Subdivision cannot help (slivers or gaps finer than the deepest cells): relabel locally.
+      // Not with label edits: those are trials of the stacking repairs, to be rejected quickly.
+      const std::vector<std::pair<int, int>> relabels = section_topology_relabels(section, leaves);
+      if (!relabels.empty()) {
+        std::vector<std::pair<QuadCell, int>> cells;
+        for (const auto& [l, f] : relabels) cells.emplace_back(leaves[l].cell, f);
+        builder.impose(cells);
+        result.topology_relabels += static_cast<int>(cells.size());
+        ++relabel_rounds;
+        continue;
+      }
+    }
+    if (stalled) {
       std::ostringstream message;
       message << "plane " << plane << " (z = " << section.z << "): " << problem << " after " << round
               << " repair rounds (level limit " << max_repair_level << ", " << leaves.size() << " cells)";

@@ -70,6 +70,7 @@ struct QuadtreeOptions {
 //   leaves           cover the unit square
 //   region_error     per face: area(Q_f Δ R_f) / area(R_f) for solid faces, 0 for the others
 //   *_splits         subdivisions made for d_a, because they were requested, for topology
+//   topology_relabels  cells relabelled where subdivision could not repair the topology
 //   deepest_level    of any leaf
 //   valid            the labelling has the topology of the contours: every face of the
 //                    arrangement has a non-empty 4-connected cell set (the outside one connected
@@ -83,6 +84,7 @@ struct QuadtreeSection {
   int accuracy_splits = 0;
   int forced_splits = 0;
   int topology_splits = 0;
+  int topology_relabels = 0;
   int deepest_level = 0;
   bool valid = false;
   std::string problem;

@@ -6,6 +6,7 @@
 #include "polycube/quadtree_section.h"
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace polycube {
@@ -18,5 +19,14 @@ namespace polycube {
 // leaves whose subdivision may repair a violation.
 std::string check_section_topology(const PlaneSection& section, const std::vector<QuadLeaf>& leaves,
                                    std::vector<char>& mark);
+
+// Where subdivision cannot repair the labelling (a sliver thinner than the deepest cells, two
+// contours closer than that), local relabellings that can: at a vertex with a face on two
+// diagonal cells only, the off-diagonal cell with most of that face's true area joins it; a
+// cell touching a face it may not touch takes the face between them; and when that changes
+// nothing, the stray components of a face (all but its largest) take their neighbours' face.
+// Returns (leaf index, new face) pairs, empty when nothing applies.
+std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& section,
+                                                           const std::vector<QuadLeaf>& leaves);
 
 }  // namespace polycube

@@ -161,13 +161,39 @@ TEST(Polycube, SmallTestMeshes) {
 
 // A tilted torus: its cross-sections move sideways from plane to plane, so extrusions of
 // neighbouring planes touch or miss each other unless the repairs step in.
-TEST(Polycube, TiltedTorusNeedsAndGetsRepairs) {
-  TriMesh mesh = test::make_torus(1.0, 0.3, 48, 24);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.6, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
+TEST(Polycube, TiltedThinTorusNeedsAndGetsRepairs) {
+  TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
   mesh.V = (mesh.V * R.transpose()).eval();
-  const TopologyResult topology = analyse_topology(mesh);
+  TopologyOptions coarse;
+  coarse.dz = 0.25;
+  const TopologyResult topology = analyse_topology(mesh, coarse);
   const PolycubeResult result = build(mesh, topology);
   expect_valid_polycube(topology, result);
+  EXPECT_FALSE(result.repairs.empty());
+  EXPECT_GT(result.rounds, 1);
+  EXPECT_GT(result.planes_inserted + result.relabelled_cells + result.stacking_splits, 0);
+}
+
+TEST(Polycube, ReslicesTheTopologyStagesSurfaceWhenItWasChanged) {
+  // When the topology stage split degenerate saddles, its sliced mesh is not the input: inserted
+  // planes must cut the surface it sliced, recovered from its refined mesh. Pretend so on a mesh
+  // that needs inserted planes; the result must be the same as from the input.
+  TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
+  mesh.V = (mesh.V * R.transpose()).eval();
+  TopologyOptions coarse;
+  coarse.dz = 0.25;
+  TopologyResult topology = analyse_topology(mesh, coarse);
+  const PolycubeResult direct = build(mesh, topology);
+  ASSERT_GT(direct.planes_inserted, 0);
+  topology.split_saddles = 1;
+  const PolycubeResult recovered = build(mesh, topology);
+  expect_valid_polycube(topology, recovered);
+  EXPECT_EQ(recovered.planes_z, direct.planes_z);
+  EXPECT_EQ(recovered.polycube.corners.size(), direct.polycube.corners.size());
+  EXPECT_EQ(recovered.model_sliced.mesh.V, direct.model_sliced.mesh.V);
+  EXPECT_EQ(recovered.model_sliced.pieces.size(), direct.model_sliced.pieces.size());
 }
 
 TEST(Polycube, BoxModelGivesTheBox) {
@@ -302,21 +328,33 @@ TEST(Polycube, RejectsBadOptions) {
 }
 
 TEST(Polycube, GivesUpWithAClearErrorWithinItsLimits) {
-  // A tilted torus needs repairs; forbidding them all must fail with AlgorithmError, never
-  // return an invalid polycube.
-  TriMesh mesh = test::make_torus(1.0, 0.15, 64, 24);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  // The tilted thin torus needs repairs; with a single round allowed the stage must fail with
+  // AlgorithmError rather than return an invalid polycube.
+  TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
   mesh.V = (mesh.V * R.transpose()).eval();
   TopologyOptions coarse;
-  coarse.dz = 0.4;
+  coarse.dz = 0.25;
   const TopologyResult topology = analyse_topology(mesh, coarse);
   PolycubeOptions options;
   options.max_rounds = 1;
   try {
-    const PolycubeResult result = build(mesh, topology, options);
-    expect_valid_polycube(topology, result);  // needed no repair at all: still valid
+    build(mesh, topology, options);
+    ADD_FAILURE() << "expected AlgorithmError";
   } catch (const AlgorithmError& e) {
-    EXPECT_NE(std::string(e.what()).find("build_polycube"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("build_polycube"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("slab"), std::string::npos) << e.what();
+  }
+  options.max_rounds = 80;
+  options.max_inserted_planes = 0;
+  options.refine_attempts = 0;
+  options.max_plane_cells = 1;  // no subdivision either: only relabelling may help
+  try {
+    const PolycubeResult result = build(mesh, topology, options);
+    expect_valid_polycube(topology, result);
+    EXPECT_EQ(result.planes_inserted, 0);
+  } catch (const AlgorithmError& e) {
+    EXPECT_NE(std::string(e.what()).find("build_polycube"), std::string::npos) << e.what();
   }
 }
 
