@@ -9,6 +9,8 @@
 #include "formats/mesh_io.h"
 #include "polycube/errors.h"
 #include "polycube/polycube_build.h"
+#include "polycube/map_audit.h"
+#include "polycube/polycube_map.h"
 #include "polycube/topology.h"
 
 #include <algorithm>
@@ -23,7 +25,7 @@ namespace polycube::cli {
 namespace {
 
 // The stages `map` can stop after, in pipeline order. The default is the last one built.
-const std::vector<std::string> kStages = {"topology", "polycube"};
+const std::vector<std::string> kStages = {"topology", "polycube", "map"};
 
 bool runs(const std::string& stop_after, const std::string& stage) {
   const auto at = [](const std::string& s) { return std::find(kStages.begin(), kStages.end(), s) - kStages.begin(); };
@@ -165,6 +167,49 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     const std::string polycube_path = (dir / "polycube.obj").string();
     write_mesh(polycube_path, polycube->polycube.mesh);
     outputs.push_back(polycube_path);
+  }
+  if (runs(options.stage, "map")) {
+    progress.stage("map", "boundary maps, slits, disk maps of " + std::to_string(polycube->piece_match.size()) + " piece pairs");
+    const PolycubeMap map = build_polycube_map(prepared.mesh, *polycube);
+    seconds["map"] = map.seconds;
+    int flipped_disks = 0, ricci_pieces = 0, ricci_iterations = 0, flat_slits = 0, slits = 0;
+    double ricci_residual = 0, min_disk_area = INFINITY;
+    for (const PieceMapStats& p : map.pieces) {
+      flipped_disks += p.flipped_model_disk + p.flipped_polycube_disk;
+      ricci_pieces += p.ricci_iterations > 0;
+      ricci_iterations = std::max(ricci_iterations, p.ricci_iterations);
+      ricci_residual = std::max(ricci_residual, p.ricci_residual);
+      flat_slits += p.flat_slits;
+      slits += p.slits;
+      min_disk_area = std::min(min_disk_area, p.min_disk_area);
+    }
+    const MapAudit audit = audit_map(prepared.mesh, polycube->polycube.mesh, map.polycube_on_model_xyz, map.model_on_polycube_xyz);
+    auto direction_json = [](const MapDirectionAudit& a) {
+      return nlohmann::json{{"triangles", a.triangles}, {"flipped", a.flipped}, {"degenerate", a.degenerate},
+                            {"max_distance", a.max_distance}, {"area_ratio", a.area_ratio}, {"ok", a.ok}};
+    };
+    report["map"] = {{"contours", map.contours},
+                     {"pieces", map.pieces.size()},
+                     {"slits", slits},
+                     {"slits_by_flat_metric", flat_slits},
+                     {"ricci", {{"pieces", ricci_pieces}, {"max_iterations", ricci_iterations}, {"max_residual", ricci_residual}}},
+                     {"flipped_disk_triangles", flipped_disks},
+                     {"min_disk_triangle_area", min_disk_area},
+                     {"polycube_to_model", direction_json(audit.polycube_to_model)},
+                     {"model_to_polycube", direction_json(audit.model_to_polycube)},
+                     {"eps_angle", audit.distortion.eps_angle},
+                     {"eps_area", audit.distortion.eps_area}};
+    TriMesh on_model = polycube->polycube.mesh;
+    on_model.V = map.polycube_on_model_xyz;
+    const std::string on_model_path = (dir / "polycube_on_model.obj").string();
+    write_mesh(on_model_path, on_model);
+    outputs.push_back(on_model_path);
+    TriMesh on_polycube = prepared.mesh;
+    on_polycube.V = map.model_on_polycube_xyz;
+    const std::string on_polycube_path = (dir / "model_on_polycube.obj").string();
+    write_mesh(on_polycube_path, on_polycube);
+    outputs.push_back(on_polycube_path);
+    progress.stage("map", std::to_string(flipped_disks) + " flipped disk triangles");
   }
 
   const std::string pieces_path = (dir / "pieces.ply").string();

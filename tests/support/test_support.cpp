@@ -26,10 +26,12 @@ const std::map<std::string, int>& closed_test_meshes() {
   return meshes;
 }
 
-TriMesh load_test_mesh(const std::string& name) {
+TriMesh load_test_mesh(const std::string& name) { return load_mesh_file(data_path(name)); }
+
+TriMesh load_mesh_file(const std::string& path) {
   PrepareOptions options;
   options.check_self_intersections = false;
-  PreparedMesh prepared = prepare_mesh(read_polygon_soup(data_path(name)), options);
+  PreparedMesh prepared = prepare_mesh(read_polygon_soup(path), options);
   require_mappable(prepared.diagnosis);
   return std::move(prepared.mesh);
 }

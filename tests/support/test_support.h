@@ -20,6 +20,9 @@ const std::map<std::string, int>& closed_test_meshes();
 // self-intersection search. Throws MeshError if it is not mappable.
 TriMesh load_test_mesh(const std::string& name);
 
+// Any mesh file read and prepared like load_test_mesh.
+TriMesh load_mesh_file(const std::string& path);
+
 // Absolute path of a file in examples/.
 std::string example_path(const std::string& name);
 

@@ -1,0 +1,164 @@
+#include "polycube/map_audit.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace polycube {
+
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using Point = Kernel::Point_3;
+using Triangle = Kernel::Triangle_3;
+using Iterator = std::vector<Triangle>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<Kernel, Iterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+// Image triangles at or below this fraction of the target area are degenerate.
+constexpr double kDegenerateArea = 1e-14;
+
+Eigen::Vector3d row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpose(); }
+
+// Area vector (twice the area along the unit normal) of face f of mesh.
+Eigen::Vector3d face_area_vector(const TriMesh& mesh, int f) {
+  const Eigen::Vector3d a = row(mesh.V, mesh.F(f, 0));
+  return (row(mesh.V, mesh.F(f, 1)) - a).cross(row(mesh.V, mesh.F(f, 2)) - a);
+}
+
+void check_faces(const TriMesh& mesh, int vertices, const char* what) {
+  if (mesh.num_faces() == 0) throw std::invalid_argument(std::string("audit_map: ") + what + " has no faces");
+  if (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= vertices)
+    throw std::invalid_argument(std::string("audit_map: ") + what + " has a face index out of range [0, " +
+                                std::to_string(vertices) + ")");
+}
+
+// Closest points on the target surface. Faces of exactly zero area are left out of the tree
+// (their points lie on a neighbour's edge in a closed mesh, and they have no normal).
+class TargetSurface {
+ public:
+  explicit TargetSurface(const TriMesh& target) {
+    triangles_.reserve(target.num_faces());
+    for (int f = 0; f < target.num_faces(); ++f) {
+      area_vectors_.push_back(face_area_vector(target, f));
+      if (area_vectors_.back().squaredNorm() == 0) continue;
+      auto point = [&](int c) {
+        const int v = target.F(f, c);
+        return Point(target.V(v, 0), target.V(v, 1), target.V(v, 2));
+      };
+      triangles_.emplace_back(point(0), point(1), point(2));
+      faces_.push_back(f);
+    }
+    if (triangles_.empty()) throw std::invalid_argument("audit_map: target has zero area");
+    tree_.rebuild(triangles_.begin(), triangles_.end());
+    tree_.accelerate_distance_queries();
+  }
+  TargetSurface(const TargetSurface&) = delete;
+  TargetSurface& operator=(const TargetSurface&) = delete;
+
+  // Closest target face to p and the distance to it.
+  std::pair<int, double> closest(const Eigen::Vector3d& p) const {
+    const Point query(p.x(), p.y(), p.z());
+    const auto [point, id] = tree_.closest_point_and_primitive(query);
+    const int face = faces_[static_cast<size_t>(id - triangles_.begin())];
+    return {face, std::sqrt(CGAL::squared_distance(query, point))};
+  }
+
+  // Twice the area times the outward unit normal of target face f.
+  const Eigen::Vector3d& area_vector(int f) const { return area_vectors_[f]; }
+
+ private:
+  std::vector<Eigen::Vector3d> area_vectors_;
+  std::vector<Triangle> triangles_;
+  std::vector<int> faces_;  // target face of each tree triangle
+  Tree tree_;
+};
+
+}  // namespace
+
+MapDirectionAudit audit_map_direction(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target,
+                                      const MapAuditOptions& options) {
+  if (!(options.surface_tolerance >= 0) || !std::isfinite(options.surface_tolerance) ||
+      !(options.area_tolerance >= 0) || !std::isfinite(options.area_tolerance))
+    throw std::invalid_argument("audit_map: tolerances must be finite and >= 0, got surface_tolerance=" +
+                                std::to_string(options.surface_tolerance) +
+                                ", area_tolerance=" + std::to_string(options.area_tolerance));
+  const int nv = source.num_vertices();
+  if (image.rows() != nv)
+    throw std::invalid_argument("audit_map: image has " + std::to_string(image.rows()) + " rows, source has " +
+                                std::to_string(nv) + " vertices");
+  check_faces(source, nv, "source");
+  check_faces(target, target.num_vertices(), "target");
+  if (!target.V.allFinite()) throw std::invalid_argument("audit_map: target has non-finite vertices");
+
+  const TargetSurface surface(target);
+  const double target_area = surface_area(target);
+  const double diagonal = bounding_box(target.V).diagonal();
+
+  // Closest target face of every image vertex (-1 when the vertex is not finite).
+  MapDirectionAudit audit;
+  audit.triangles = source.num_faces();
+  std::vector<int> vertex_face(nv, -1);
+  for (int v = 0; v < nv; ++v) {
+    if (!image.row(v).allFinite()) {
+      audit.max_distance = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const auto [face, distance] = surface.closest(row(image, v));
+    vertex_face[v] = face;
+    audit.max_distance = std::max(audit.max_distance, diagonal > 0 ? distance / diagonal : distance);
+  }
+
+  double image_area = 0;
+  for (int f = 0; f < source.num_faces(); ++f) {
+    const int corner[3] = {source.F(f, 0), source.F(f, 1), source.F(f, 2)};
+    if (vertex_face[corner[0]] < 0 || vertex_face[corner[1]] < 0 || vertex_face[corner[2]] < 0) {
+      ++audit.degenerate;
+      continue;
+    }
+    const Eigen::Vector3d a = row(image, corner[0]), b = row(image, corner[1]), c = row(image, corner[2]);
+    const Eigen::Vector3d normal = (b - a).cross(c - a);
+    const double area = 0.5 * normal.norm();
+    image_area += area;
+    if (area <= kDegenerateArea * target_area) {
+      ++audit.degenerate;
+      continue;
+    }
+    // The target's outward normal near the triangle: the distinct faces closest to its centroid
+    // and to its corners, area-weighted. Across a polycube edge the corners find both faces, and
+    // a correctly oriented chord has a positive dot product with each of them.
+    int faces[4] = {surface.closest((a + b + c) / 3).first, vertex_face[corner[0]], vertex_face[corner[1]],
+                    vertex_face[corner[2]]};
+    std::sort(faces, faces + 4);
+    Eigen::Vector3d nearby = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k)
+      if (k == 0 || faces[k] != faces[k - 1]) nearby += surface.area_vector(faces[k]);
+    if (normal.dot(nearby) <= 0) ++audit.flipped;
+  }
+  audit.area_ratio = image_area / target_area;
+  audit.ok = audit.flipped == 0 && audit.degenerate == 0 && audit.max_distance <= options.surface_tolerance &&
+             std::abs(audit.area_ratio - 1) <= options.area_tolerance;
+  return audit;
+}
+
+MapAudit audit_map(const TriMesh& model, const TriMesh& polycube, const Eigen::MatrixX3d& polycube_on_model,
+                   const Eigen::MatrixX3d& model_on_polycube, const MapAuditOptions& options) {
+  MapAudit audit;
+  audit.polycube_to_model = audit_map_direction(polycube, polycube_on_model, model, options);
+  audit.model_to_polycube = audit_map_direction(model, model_on_polycube, polycube, options);
+  audit.distortion = map_distortion(polycube, polycube_on_model);
+  audit.ok = audit.polycube_to_model.ok && audit.model_to_polycube.ok;
+  return audit;
+}
+
+}  // namespace polycube

@@ -1,0 +1,56 @@
+// Work over independent items (pieces, contours) spread over threads, with the errors of the
+// items reported deterministically (the lowest failing item's, prefixed with its name).
+#pragma once
+
+#include "polycube/errors.h"
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace polycube {
+
+// Calls work(i) for every i in `order` (largest items first is best), on `threads` threads (0:
+// one per hardware thread), at most one thread per item. If items throw, rethrows the error of
+// the smallest such i, a MeshError or AlgorithmError with its message prefixed by
+// "<what> <i>: ". Returns the number of threads used.
+template <class Work>
+int parallel_for_each(const std::vector<int>& order, int threads, const std::string& what, Work&& work) {
+  const int n = static_cast<int>(order.size());
+  int max_index = -1;
+  for (int i : order) max_index = std::max(max_index, i);
+  std::vector<std::exception_ptr> errors(max_index + 1);
+  std::atomic<int> next{0};
+  auto run = [&]() {
+    for (int k = next++; k < n; k = next++) {
+      try {
+        work(order[k]);
+      } catch (...) {
+        errors[order[k]] = std::current_exception();
+      }
+    }
+  };
+  if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::clamp(threads, 1, std::max(1, n));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(run);
+  run();
+  for (std::thread& t : pool) t.join();
+  for (size_t i = 0; i < errors.size(); ++i) {
+    if (!errors[i]) continue;
+    const std::string prefix = what + " " + std::to_string(i) + ": ";
+    try {
+      std::rethrow_exception(errors[i]);
+    } catch (const MeshError& e) {
+      throw MeshError(prefix + e.what());
+    } catch (const AlgorithmError& e) {
+      throw AlgorithmError(prefix + e.what());
+    }
+  }
+  return threads;
+}
+
+}  // namespace polycube

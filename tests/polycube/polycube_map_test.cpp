@@ -1,0 +1,218 @@
+// build_polycube_map (§3.4): per piece pair both disk maps are embeddings; the glued map and its
+// inverse land on the surfaces, undo each other, and agree across the cutting contours; the
+// boundary map ψ keeps anchors and orientation.
+#include "polycube/polycube_map.h"
+
+#include "polycube/contour_map.h"
+#include "polycube/map_audit.h"
+#include "polycube/mesh_topology.h"
+#include "polycube/piece_disk.h"
+#include "polycube/topology.h"
+#include "support/generated_meshes.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace polycube {
+namespace {
+
+using namespace test;
+
+struct Pipeline {
+  TriMesh model;
+  PolycubeResult polycube;
+  PolycubeMap map;
+};
+
+Pipeline run(const TriMesh& model) {
+  Pipeline p;
+  p.model = model;
+  const TopologyResult topology = analyse_topology(model);
+  p.polycube = build_polycube(model, topology);
+  p.map = build_polycube_map(model, p.polycube);
+  return p;
+}
+
+// A random point of a random face (area-weighted is not needed here).
+SurfacePoint random_point(const TriMesh& mesh, std::mt19937& rng) {
+  std::uniform_int_distribution<int> face(0, mesh.num_faces() - 1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double a = unit(rng), b = unit(rng);
+  if (a + b > 1) {
+    a = 1 - a;
+    b = 1 - b;
+  }
+  SurfacePoint p;
+  p.face = face(rng);
+  p.bary = Eigen::Vector3d(1 - a - b, a, b);
+  return p;
+}
+
+class PolycubeMapOnMeshes : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(PolycubeMapOnMeshes, DisksEmbedImagesOnSurfacesRoundTrip) {
+  const std::string name = GetParam();
+  const TriMesh model = name == "rocker-arm.obj" ? load_mesh_file(example_path(name)) : load_test_mesh(name);
+  const Pipeline p = run(model);
+  const TriMesh& P = p.polycube.polycube.mesh;
+  ASSERT_EQ(p.map.pieces.size(), p.polycube.model_sliced.pieces.size());
+  for (const PieceMapStats& s : p.map.pieces) {
+    EXPECT_EQ(s.flipped_model_disk, 0) << name << " piece " << s.model_piece;
+    EXPECT_EQ(s.flipped_polycube_disk, 0) << name << " piece " << s.model_piece;
+    EXPECT_GT(s.min_disk_area, 0) << name << " piece " << s.model_piece;
+    EXPECT_EQ(s.slits, s.loops - 1) << name << " piece " << s.model_piece;
+  }
+  ASSERT_EQ(p.map.polycube_on_model_xyz.rows(), P.num_vertices());
+  ASSERT_EQ(p.map.model_on_polycube_xyz.rows(), model.num_vertices());
+
+  // Images lie on the other surface (judged by the independent audit).
+  const MapAudit audit = audit_map(model, P, p.map.polycube_on_model_xyz, p.map.model_on_polycube_xyz);
+  EXPECT_LT(audit.polycube_to_model.max_distance, 1e-9) << name;
+  EXPECT_LT(audit.model_to_polycube.max_distance, 1e-9) << name;
+  EXPECT_EQ(audit.polycube_to_model.degenerate + audit.model_to_polycube.degenerate, 0) << name;
+
+  // φ⁻¹ ∘ φ and φ ∘ φ⁻¹ are the identity at random points.
+  const double diagonal = bounding_box(model.V).diagonal();
+  std::mt19937 rng(7);
+  double worst = 0;
+  for (int k = 0; k < 300; ++k) {
+    const SurfacePoint x = random_point(P, rng);
+    const Eigen::Vector3d back = surface_position(P, p.map.to_polycube(p.map.to_model(x)));
+    worst = std::max(worst, (back - surface_position(P, x)).norm());
+    const SurfacePoint y = random_point(model, rng);
+    const Eigen::Vector3d forth = surface_position(model, p.map.to_model(p.map.to_polycube(y)));
+    worst = std::max(worst, (forth - surface_position(model, y)).norm());
+  }
+  EXPECT_LT(worst / diagonal, 1e-7) << name;
+
+  // Continuous across the contours: the two sides of a plane, 2e-11 of the diagonal apart inside
+  // one triangle of P, land next to each other on the model (a seam would leave a gap of the
+  // order of the mesh spacing).
+  int crossings = 0;
+  double jump = 0;
+  for (int f = 0; f < P.num_faces() && crossings < 200; ++f) {
+    const Eigen::Vector3d a = P.V.row(P.F(f, 0)), b = P.V.row(P.F(f, 1)), c = P.V.row(P.F(f, 2));
+    for (double z : p.polycube.planes_z) {
+      // Where the plane crosses edge ab (if it does), nudged up and down along the edge.
+      if ((a.z() - z) * (b.z() - z) >= 0) continue;
+      const double t = (z - a.z()) / (b.z() - a.z());
+      const double dt = 1e-11 * diagonal / (b - a).norm();
+      SurfacePoint lo, hi;
+      lo.face = hi.face = f;
+      lo.bary = Eigen::Vector3d(1 - (t - dt), t - dt, 0);
+      hi.bary = Eigen::Vector3d(1 - (t + dt), t + dt, 0);
+      const Eigen::Vector3d ml = surface_position(model, p.map.to_model(lo)), mh = surface_position(model, p.map.to_model(hi));
+      jump = std::max(jump, (ml - mh).norm());
+      ++crossings;
+      (void)c;
+    }
+  }
+  EXPECT_GT(crossings, 0) << name;
+  EXPECT_LT(jump / diagonal, 1e-6) << name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Meshes, PolycubeMapOnMeshes,
+                         ::testing::Values("sphere.off", "eight.off", "knot.off", "helmet.off", "double-torus-example.off", "rocker-arm.obj"),
+                         [](const auto& info) {
+                           std::string s = info.param.substr(0, info.param.find('.'));
+                           for (char& ch : s)
+                             if (ch == '-') ch = '_';
+                           return s;
+                         });
+
+// On a finely meshed model the image of P covers the model's area (the 2 %).
+TEST(PolycubeMap, ImageOfPolycubeCoversTheModel) {
+  const TriMesh model = load_mesh_file(example_path("rocker-arm.obj"));
+  const Pipeline p = run(model);
+  const MapAudit audit = audit_map(model, p.polycube.polycube.mesh, p.map.polycube_on_model_xyz, p.map.model_on_polycube_xyz);
+  EXPECT_NEAR(audit.polycube_to_model.area_ratio, 1.0, 0.02);
+}
+
+// ψ on a circle and a square around the same centre: both counter-clockwise whatever the input
+// orientation, anchors get equal u, u is increasing along both curves, and the rotation found by
+// eq. 6 puts the square's corners next to the circle's points at the same angle.
+TEST(ContourMap, CircleToSquare) {
+  const int n = 96;
+  Eigen::MatrixX3d circle(n, 3), square(16, 3);
+  std::vector<int> circle_loop, square_loop;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n + 0.3;  // starts at angle 0.3
+    circle.row(i) << std::cos(t), std::sin(t), 0.5;
+    circle_loop.push_back(n - 1 - i);  // clockwise on input
+  }
+  for (int i = 0; i < 16; ++i) {
+    const int side = i / 4, k = i % 4;
+    const double s = -1 + 0.5 * k;
+    Eigen::Vector2d q;
+    if (side == 0) q = {1, s};
+    if (side == 1) q = {-s, 1};
+    if (side == 2) q = {-1, -s};
+    if (side == 3) q = {s, -1};
+    square.row(i) << 0.9 * q.x(), 0.9 * q.y(), 0.5;
+    square_loop.push_back(i);
+  }
+  ContourMap map = start_contour_map(circle_loop, circle, square_loop, square);
+  // Counter-clockwise: positive shoelace area.
+  auto area = [](const std::vector<int>& loop, const Eigen::MatrixX3d& V) {
+    double a = 0;
+    for (size_t i = 0; i < loop.size(); ++i) {
+      const auto p = V.row(loop[i]), q = V.row(loop[(i + 1) % loop.size()]);
+      a += p.x() * q.y() - q.x() * p.y();
+    }
+    return a;
+  };
+  EXPECT_GT(area(map.model_vertices, circle), 0);
+  EXPECT_GT(area(map.polycube_vertices, square), 0);
+  add_anchor(map, 10);
+  add_anchor(map, 50);
+  add_anchor(map, 10);
+  finish_contour_map(map, circle, square);
+  ASSERT_EQ(map.anchors.size(), 2u);
+  for (const auto& [m, q] : map.anchors) EXPECT_EQ(map.model_u[m], map.polycube_u[q]);
+  EXPECT_EQ(anchor_of(map, 10), map.anchors[0].first == 10 ? map.anchors[0].second : map.anchors[1].second);
+  // ψ moves points by less than the gap between the curves plus the polygon's corner offset.
+  EXPECT_LT(map.rms_distance, 0.3);
+  // u increases along both loops (one wrap each).
+  auto wraps = [](const std::vector<double>& u) {
+    int w = 0;
+    for (size_t i = 0; i < u.size(); ++i) w += u[(i + 1) % u.size()] < u[i];
+    return w;
+  };
+  EXPECT_EQ(wraps(map.model_u), 1);
+  EXPECT_EQ(wraps(map.polycube_u), 1);
+  EXPECT_TRUE(std::is_sorted(map.u.begin(), map.u.end()));
+  EXPECT_EQ(map.u.size(), map.model_at.size());
+}
+
+// A tube cut by one slit is a disk; its embedding has no flipped triangle, and splitting inner
+// edges keeps the boundary and the area.
+TEST(PieceDisk, TubeCutAndEmbedded) {
+  const TriMesh tube = make_tube(1.0, 2.0, 24, 6);
+  const std::vector<std::vector<int>> loops = boundary_loops(tube.F);
+  ASSERT_EQ(loops.size(), 2u);
+  const EdgeLength length = [&](int a, int b) { return (tube.V.row(a) - tube.V.row(b)).norm(); };
+  const std::vector<Slit> slits = find_slits(tube, loops, 0, length);
+  ASSERT_EQ(slits.size(), 1u);
+  const CutDisk cut = cut_open(tube, slits);
+  EXPECT_EQ(cut.mesh.num_vertices(), tube.num_vertices() + static_cast<int>(slits[0].path.size()));
+  const int nb = static_cast<int>(cut.boundary.size());
+  std::vector<double> angle(nb);
+  for (int k = 0; k < nb; ++k) angle[k] = 2 * M_PI * k / nb;
+  const DiskEmbedding disk = embed_disk(cut, angle, std::vector<std::vector<std::pair<double, double>>>(nb));
+  EXPECT_EQ(disk.flipped, 0);
+  EXPECT_GT(disk.min_area, 0);
+
+  std::vector<int> parent;
+  const TriMesh split = split_inner_edges(tube, parent);
+  EXPECT_NEAR(surface_area(split), surface_area(tube), 1e-12);
+  EXPECT_EQ(boundary_loops(split.F).size(), 2u);
+  EXPECT_EQ(static_cast<int>(parent.size()), split.num_faces());
+}
+
+}  // namespace
+}  // namespace polycube
