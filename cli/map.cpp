@@ -102,6 +102,27 @@ void write_polycube_preview(const std::string& path, const PolycubeResult& resul
   write_image(path, render_tiles({model, polycube}, options));
 }
 
+// The map at a glance: the model with a checkerboard carried from P through φ⁻¹ beside P with the
+// same checkers, both shaded, from the same 3/4 view and at the same scale. Checkers are cubes of
+// 1/24 of P's diagonal, shifted off P's faces so that no face lies on a cell boundary.
+void write_map_preview(const std::string& path, const TriMesh& model, const Polycube& polycube, const PolycubeMap& map) {
+  const double cell = bounding_box(polycube.mesh.V).diagonal() / 24;
+  const Eigen::RowVector3d shift = Eigen::RowVector3d::Constant(0.3819660112501051 * cell);
+  const Eigen::MatrixX3d model_coords = map.model_on_polycube_xyz.rowwise() + shift;
+  const Eigen::MatrixX3d polycube_coords = polycube.mesh.V.rowwise() + shift;
+  RenderItem m, p;
+  m.mesh = &model;
+  m.checker_coords = &model_coords;
+  m.checker_size = cell;
+  p.mesh = &polycube.mesh;
+  p.checker_coords = &polycube_coords;
+  p.checker_size = cell;
+  p.smooth = false;
+  RenderOptions options;
+  options.same_scale = true;
+  write_image(path, render_tiles({m, p}, options));
+}
+
 nlohmann::json polycube_json(const PolycubeResult& result) {
   const Polycube& p = result.polycube;
   return {{"vertices", p.mesh.num_vertices()},
@@ -154,6 +175,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   nlohmann::json seconds = {{"topology", topology.seconds_total}};
   const SlicedMesh* model_pieces = &topology.sliced;
   std::optional<PolycubeResult> polycube;
+  std::optional<PolycubeMap> map;
   if (runs(options.stage, "polycube")) {
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
     polycube = build_polycube(prepared.mesh, topology, options.polycube);
@@ -170,11 +192,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   }
   if (runs(options.stage, "map")) {
     progress.stage("map", "boundary maps, slits, disk maps of " + std::to_string(polycube->piece_match.size()) + " piece pairs");
-    const PolycubeMap map = build_polycube_map(prepared.mesh, *polycube);
-    seconds["map"] = map.seconds;
+    map = build_polycube_map(prepared.mesh, *polycube);
+    seconds["map"] = map->seconds;
     int flipped_disks = 0, ricci_pieces = 0, ricci_iterations = 0, flat_slits = 0, slits = 0;
     double ricci_residual = 0, min_disk_area = INFINITY;
-    for (const PieceMapStats& p : map.pieces) {
+    for (const PieceMapStats& p : map->pieces) {
       flipped_disks += p.flipped_model_disk + p.flipped_polycube_disk;
       ricci_pieces += p.ricci_iterations > 0;
       ricci_iterations = std::max(ricci_iterations, p.ricci_iterations);
@@ -183,13 +205,13 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       slits += p.slits;
       min_disk_area = std::min(min_disk_area, p.min_disk_area);
     }
-    const MapAudit audit = audit_map(prepared.mesh, polycube->polycube.mesh, map.polycube_on_model_xyz, map.model_on_polycube_xyz);
+    const MapAudit audit = audit_map(prepared.mesh, polycube->polycube.mesh, map->polycube_on_model_xyz, map->model_on_polycube_xyz);
     auto direction_json = [](const MapDirectionAudit& a) {
       return nlohmann::json{{"triangles", a.triangles}, {"flipped", a.flipped}, {"degenerate", a.degenerate},
                             {"max_distance", a.max_distance}, {"area_ratio", a.area_ratio}, {"ok", a.ok}};
     };
-    report["map"] = {{"contours", map.contours},
-                     {"pieces", map.pieces.size()},
+    report["map"] = {{"contours", map->contours},
+                     {"pieces", map->pieces.size()},
                      {"slits", slits},
                      {"slits_by_flat_metric", flat_slits},
                      {"ricci", {{"pieces", ricci_pieces}, {"max_iterations", ricci_iterations}, {"max_residual", ricci_residual}}},
@@ -200,12 +222,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"eps_angle", audit.distortion.eps_angle},
                      {"eps_area", audit.distortion.eps_area}};
     TriMesh on_model = polycube->polycube.mesh;
-    on_model.V = map.polycube_on_model_xyz;
+    on_model.V = map->polycube_on_model_xyz;
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
     write_mesh(on_model_path, on_model);
     outputs.push_back(on_model_path);
     TriMesh on_polycube = prepared.mesh;
-    on_polycube.V = map.model_on_polycube_xyz;
+    on_polycube.V = map->model_on_polycube_xyz;
     const std::string on_polycube_path = (dir / "model_on_polycube.obj").string();
     write_mesh(on_polycube_path, on_polycube);
     outputs.push_back(on_polycube_path);
@@ -216,7 +238,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   write_pieces(pieces_path, *model_pieces);
   outputs.push_back(pieces_path);
   const std::string preview_path = (dir / "preview.png").string();
-  if (polycube)
+  if (map)
+    write_map_preview(preview_path, prepared.mesh, polycube->polycube, *map);
+  else if (polycube)
     write_polycube_preview(preview_path, *polycube);
   else
     write_pieces_preview(preview_path, *model_pieces);

@@ -136,8 +136,110 @@ ContourMap start_contour_map(const std::vector<int>& model_loop, const Eigen::Ma
     }
   }
   map.offset = wrap01(0.5 * (lo + hi));
+
+  // Eq. 6 over monotone correspondences: dynamic programming on samples P_i, i = 0..K, against
+  // M_j at arc length offset + j / K, from (0, 0) to (K, K); steps (1,1), (1,0), (0,1), the last
+  // two penalised by the squared sample spacing so that the correspondence only bends where it
+  // brings points closer.
+  const int K = 512;
+  std::vector<Eigen::Vector3d> pk(K + 1), mk(K + 1);
+  double spacing = 0;
+  for (int k = 0; k <= K; ++k) {
+    pk[k] = position(map.polycube_vertices, polycube_V, locate(map.polycube_u, static_cast<double>(k) / K));
+    mk[k] = position(map.model_vertices, model_V, locate(map.model_u, map.offset + static_cast<double>(k) / K));
+    if (k > 0) spacing += (mk[k] - mk[k - 1]).norm() + (pk[k] - pk[k - 1]).norm();
+  }
+  spacing /= 2 * K;
+  const double penalty = 4 * spacing * spacing;
+  const int band = K / 4;  // |i - j| <= band
+  const int width = 2 * band + 1;
+  std::vector<double> cost((K + 1) * width, INFINITY);
+  std::vector<unsigned char> step((K + 1) * width, 0);
+  auto at = [&](int i, int j) { return i * width + (j - i + band); };
+  auto inside = [&](int i, int j) { return j >= 0 && j <= K && std::abs(i - j) <= band; };
+  cost[at(0, 0)] = 0;
+  for (int i = 0; i <= K; ++i)
+    for (int j = std::max(0, i - band); j <= std::min(K, i + band); ++j) {
+      if (i == 0 && j == 0) continue;
+      const double d = (pk[i] - mk[j]).squaredNorm();
+      double best = INFINITY;
+      unsigned char from = 0;
+      if (i > 0 && j > 0 && inside(i - 1, j - 1) && cost[at(i - 1, j - 1)] + d < best) {
+        best = cost[at(i - 1, j - 1)] + d;
+        from = 1;
+      }
+      if (i > 0 && inside(i - 1, j) && cost[at(i - 1, j)] + d + penalty < best) {
+        best = cost[at(i - 1, j)] + d + penalty;
+        from = 2;
+      }
+      if (j > 0 && inside(i, j - 1) && cost[at(i, j - 1)] + d + penalty < best) {
+        best = cost[at(i, j - 1)] + d + penalty;
+        from = 3;
+      }
+      cost[at(i, j)] = best;
+      step[at(i, j)] = from;
+    }
+  // Trace back; per P sample the mean matched M sample.
+  std::vector<double> sum(K + 1, 0.0), count(K + 1, 0.0);
+  for (int i = K, j = K; i > 0 || j > 0;) {
+    sum[i] += j;
+    count[i] += 1;
+    const unsigned char from = step[at(i, j)];
+    if (from == 1) {
+      --i;
+      --j;
+    } else if (from == 2) {
+      --i;
+    } else if (from == 3) {
+      --j;
+    } else {
+      break;
+    }
+  }
+  sum[0] += 0;
+  count[0] += 1;
+  std::vector<double> shift(K + 1);  // matched j minus i
+  for (int i = 0; i <= K; ++i) shift[i] = sum[i] / count[i] - i;
+  // Smooth the staircase of the sampled path (cyclic moving average over ±8 samples).
+  std::vector<double> smooth(K + 1);
+  for (int i = 0; i <= K; ++i) {
+    double acc = 0;
+    for (int w = -8; w <= 8; ++w) acc += shift[((i + w) % K + K) % K];
+    smooth[i] = acc / 17;
+  }
+  smooth[K] = smooth[0];
+  map.psi_p.resize(K + 1);
+  map.psi_m.resize(K + 1);
+  for (int i = 0; i <= K; ++i) {
+    map.psi_p[i] = static_cast<double>(i) / K;
+    map.psi_m[i] = map.offset + (i + smooth[i]) / K;
+  }
+  // Strictly increasing, ending one turn after the start.
+  map.psi_m[K] = map.psi_m[0] + 1;
+  for (int i = 1; i <= K; ++i) map.psi_m[i] = std::max(map.psi_m[i], map.psi_m[i - 1] + 1e-9);
+  if (map.psi_m[K] > map.psi_m[0] + 1 + 1e-12) {
+    // Rounding pushed the end: rescale to one turn.
+    const double span = map.psi_m[K] - map.psi_m[0];
+    for (int i = 1; i <= K; ++i) map.psi_m[i] = map.psi_m[0] + (map.psi_m[i] - map.psi_m[0]) / span;
+  }
   return map;
 }
+
+namespace {
+
+// F⁻¹: the P arc length (in [0, 1)) corresponding to model arc length s.
+double model_to_polycube_length(const ContourMap& map, double s) {
+  if (map.psi_m.empty()) return wrap01(s - map.offset);
+  const double lo = map.psi_m.front();
+  const double t = lo + wrap01(s - lo);
+  const size_t k = std::upper_bound(map.psi_m.begin(), map.psi_m.end(), t) - map.psi_m.begin();
+  if (k == 0) return 0;
+  if (k >= map.psi_m.size()) return wrap01(map.psi_p.back());
+  const double f = (t - map.psi_m[k - 1]) / (map.psi_m[k] - map.psi_m[k - 1]);
+  return wrap01(map.psi_p[k - 1] + f * (map.psi_p[k] - map.psi_p[k - 1]));
+}
+
+}  // namespace
 
 void add_anchor(ContourMap& map, int model_index) {
   for (const auto& a : map.anchors)
@@ -160,7 +262,7 @@ void pin_anchors(ContourMap& map, std::vector<std::pair<int, int>>& anchors) {
   const int n = static_cast<int>(map.polycube_vertices.size());
   const int k_count = static_cast<int>(anchors.size());
   if (k_count > n) throw AlgorithmError("a contour's polygon has fewer vertices (" + std::to_string(n) + ") than slit ends (" + std::to_string(k_count) + ")");
-  auto target = [&](int k) { return wrap01(map.model_u[anchors[k].first] - map.offset); };
+  auto target = [&](int k) { return model_to_polycube_length(map, map.model_u[anchors[k].first]); };
   int first = 0;
   for (int i = 1; i < n; ++i)
     if (circular_distance(map.polycube_u[i], target(0)) < circular_distance(map.polycube_u[first], target(0))) first = i;
@@ -189,9 +291,12 @@ void pin_anchors(ContourMap& map, std::vector<std::pair<int, int>>& anchors) {
 }  // namespace
 
 void finish_contour_map(ContourMap& map, const Eigen::MatrixX3d& model_V, const Eigen::MatrixX3d& polycube_V) {
-  const std::vector<double> s_model = map.model_u, s_poly = map.polycube_u;
+  const std::vector<double> s_poly = map.polycube_u;
+  // Model vertices in P's arc length through F⁻¹ (monotone, so the order is kept).
+  std::vector<double> s_model = map.model_u;
+  for (double& x : s_model) x = model_to_polycube_length(map, x);
   if (map.anchors.empty()) {
-    for (double& u : map.model_u) u = wrap01(u - map.offset);
+    map.model_u = s_model;
   } else {
     std::vector<std::pair<int, int>> anchors = map.anchors;
     const double m0 = s_model[anchors.front().first];
@@ -212,8 +317,9 @@ void finish_contour_map(ContourMap& map, const Eigen::MatrixX3d& model_V, const 
     m_knot.push_back(1);
     p_knot.push_back(1);
     for (double& u : map.polycube_u) u = wrap01(u - p_start);
-    for (double& u : map.model_u) {
-      const double rel = wrap01(u - m_start);
+    for (size_t i = 0; i < map.model_u.size(); ++i) {
+      double& u = map.model_u[i];
+      const double rel = wrap01(s_model[i] - m_start);
       const size_t k = std::upper_bound(m_knot.begin(), m_knot.end(), rel) - m_knot.begin() - 1;
       const double span = m_knot[k + 1] - m_knot[k];
       u = p_knot[k] + (span > 0 ? (rel - m_knot[k]) / span : 0.0) * (p_knot[k + 1] - p_knot[k]);

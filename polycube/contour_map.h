@@ -3,10 +3,13 @@
 // there, so the piecewise map is continuous across the cut.
 //
 // Both curves get one common parameter u in [0, 1): on P's polygon u is the normalised arc length
-// from a start vertex; on the model's contour u is the normalised arc length too, shifted by the
-// offset that minimises ∫ |ψ(v) − v|² (eq. 6 over rotations of the arc-length parametrisation),
-// and pinned piecewise linearly so that chosen pairs of vertices ("anchors": where the slits of
-// §3.4 end) have exactly the same u. ψ maps the point of P at u to the point of the model at u.
+// from a start vertex; on the model's contour u comes from the monotone correspondence F between
+// the two arc lengths that minimises eq. 6, ∫ |ψ(v) − v|², plus a small penalty on stretching
+// (dynamic programming over uniform samples of both curves, started at the best rotation, then
+// smoothed), pinned piecewise linearly so that chosen pairs of vertices ("anchors": where the slits
+// of §3.4 end) have exactly the same u. ψ maps the point of P at u to the point of the model at u.
+// Following the nearest points rather than plain arc length keeps the correspondence of
+// consecutive contours aligned, so pieces between them are not twisted.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,7 +29,9 @@ struct LoopPosition {
 //   model_vertices, polycube_vertices  vertex ids (of the sliced model and the sliced polycube),
 //                counter-clockwise seen from +z
 //   model_u, polycube_u  the common parameter of each vertex
-//   offset       the eq. 6 rotation of the model's arc length against P's (before pinning)
+//   offset       the eq. 6 rotation of the model's arc length against P's (start of F)
+//   psi_p, psi_m F as a table: P arc length psi_p (0 .. 1, increasing) to model arc length psi_m
+//                (offset .. offset + 1, strictly increasing)
 //   rms_distance sqrt of the mean of |ψ(v) − v|² over P's polygon, input units (after pinning)
 //   anchors      pairs (index into model_vertices, index into polycube_vertices) with equal u
 //   u            the union of both curves' vertex parameters, ascending, each once (a model vertex
@@ -38,6 +43,7 @@ struct ContourMap {
   std::vector<double> model_u;
   std::vector<double> polycube_u;
   double offset = 0;
+  std::vector<double> psi_p, psi_m;
   double rms_distance = 0;
   std::vector<std::pair<int, int>> anchors;
   std::vector<double> u;
