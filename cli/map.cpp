@@ -7,6 +7,7 @@
 #include "formats/atomic_file.h"
 #include "formats/image_io.h"
 #include "formats/mesh_io.h"
+#include "polycube/align.h"
 #include "polycube/errors.h"
 #include "polycube/polycube_build.h"
 #include "polycube/map_audit.h"
@@ -36,6 +37,7 @@ struct MapOptions {
   MeshInput input;
   std::string output_dir;
   std::string stage = kStages.back();
+  std::string align = "auto";
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -164,21 +166,57 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   report["input"] = diagnosis_json(prepared);
   report["input"]["file"] = options.input.path;
   report["parameters"] = {{"dz", options.topology.dz}, {"da", options.polycube.da}, {"stage", options.stage}};
+  report["parameters"]["align"] = options.align;
   std::vector<std::string> outputs;
 
+  // The pipeline runs on the model turned into the chosen frame; outputs go back to the input's.
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Alignment alignment;
+  double align_seconds = 0;
+  if (options.align == "auto" && options.stage != "topology") {
+    const double align_start = progress.elapsed_seconds();
+    progress.stage("align", "scoring 6 orientations (input frame, principal axes) by polycube corners");
+    alignment = choose_alignment(prepared.mesh, options.topology, options.polycube);
+    nlohmann::json candidates = nlohmann::json::array();
+    for (const AlignmentCandidate& c : alignment.candidates)
+      candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"seconds", c.seconds}, {"error", c.error}});
+    report["alignment"]["candidates"] = candidates;
+    align_seconds = progress.elapsed_seconds() - align_start;
+    if (alignment.chosen >= 0) {
+      rotation = alignment.rotation;
+      const AlignmentCandidate& chosen = alignment.candidates[alignment.chosen];
+      report["alignment"]["chosen"] = chosen.name;
+      progress.stage("align", chosen.name + " (" + std::to_string(chosen.corners) + " corners)");
+    } else {
+      report["alignment"]["chosen"] = "input frame, z up (no candidate passed the scoring budget)";
+      progress.warning("align: no orientation passed the scoring budget; keeping the input frame");
+    }
+  }
+  report["alignment"]["rotation"] = {{rotation(0, 0), rotation(0, 1), rotation(0, 2)},
+                                     {rotation(1, 0), rotation(1, 1), rotation(1, 2)},
+                                     {rotation(2, 0), rotation(2, 1), rotation(2, 2)}};
+  const TriMesh model = rotated(prepared.mesh, rotation);
+  // Positions of the turned frame back in the input's (x = rotation^T x_turned).
+  auto to_input = [&rotation](const Eigen::MatrixX3d& V) -> Eigen::MatrixX3d { return V * rotation; };
+  auto mesh_to_input = [&](const TriMesh& m) {
+    TriMesh out = m;
+    out.V = to_input(m.V);
+    return out;
+  };
+
   progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
-  const TopologyResult topology = analyse_topology(prepared.mesh, options.topology);
+  const TopologyResult topology = alignment.topology ? std::move(*alignment.topology) : analyse_topology(model, options.topology);
   report["topology"] = topology_json(topology);
   progress.stage("topology", std::to_string(topology.critical.saddle_count()) + " saddles, " +
                                  std::to_string(topology.planes_z.size()) + " planes, " +
                                  std::to_string(topology.sliced.pieces.size()) + " genus-0 pieces");
-  nlohmann::json seconds = {{"topology", topology.seconds_total}};
+  nlohmann::json seconds = {{"align", align_seconds}, {"topology", topology.seconds_total}};
   const SlicedMesh* model_pieces = &topology.sliced;
   std::optional<PolycubeResult> polycube;
   std::optional<PolycubeMap> map;
   if (runs(options.stage, "polycube")) {
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
-    polycube = build_polycube(prepared.mesh, topology, options.polycube);
+    polycube = alignment.polycube ? std::move(*alignment.polycube) : build_polycube(model, topology, options.polycube);
     model_pieces = &polycube->model_sliced;
     report["polycube"] = polycube_json(*polycube);
     seconds["polycube"] = polycube->seconds_total;
@@ -187,12 +225,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                                    std::to_string(polycube->polycube.faces.size()) + " faces, " +
                                    std::to_string(polycube->polycube_sliced.pieces.size()) + " pieces matched");
     const std::string polycube_path = (dir / "polycube.obj").string();
-    write_mesh(polycube_path, polycube->polycube.mesh);
+    write_mesh(polycube_path, mesh_to_input(polycube->polycube.mesh));
     outputs.push_back(polycube_path);
   }
   if (runs(options.stage, "map")) {
     progress.stage("map", "boundary maps, slits, disk maps of " + std::to_string(polycube->piece_match.size()) + " piece pairs");
-    map = build_polycube_map(prepared.mesh, *polycube);
+    map = build_polycube_map(model, *polycube);
     seconds["map"] = map->seconds;
     int flipped_disks = 0, ricci_pieces = 0, ricci_iterations = 0, flat_slits = 0, slits = 0;
     double ricci_residual = 0, min_disk_area = INFINITY;
@@ -205,7 +243,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       slits += p.slits;
       min_disk_area = std::min(min_disk_area, p.min_disk_area);
     }
-    const MapAudit audit = audit_map(prepared.mesh, polycube->polycube.mesh, map->polycube_on_model_xyz, map->model_on_polycube_xyz);
+    const MapAudit audit = audit_map(model, polycube->polycube.mesh, map->polycube_on_model_xyz, map->model_on_polycube_xyz);
     auto direction_json = [](const MapDirectionAudit& a) {
       return nlohmann::json{{"triangles", a.triangles}, {"flipped", a.flipped}, {"degenerate", a.degenerate},
                             {"max_distance", a.max_distance}, {"area_ratio", a.area_ratio}, {"ok", a.ok}};
@@ -222,12 +260,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"eps_angle", audit.distortion.eps_angle},
                      {"eps_area", audit.distortion.eps_area}};
     TriMesh on_model = polycube->polycube.mesh;
-    on_model.V = map->polycube_on_model_xyz;
+    on_model.V = to_input(map->polycube_on_model_xyz);
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
     write_mesh(on_model_path, on_model);
     outputs.push_back(on_model_path);
     TriMesh on_polycube = prepared.mesh;
-    on_polycube.V = map->model_on_polycube_xyz;
+    on_polycube.V = to_input(map->model_on_polycube_xyz);
     const std::string on_polycube_path = (dir / "model_on_polycube.obj").string();
     write_mesh(on_polycube_path, on_polycube);
     outputs.push_back(on_polycube_path);
@@ -235,11 +273,13 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   }
 
   const std::string pieces_path = (dir / "pieces.ply").string();
-  write_pieces(pieces_path, *model_pieces);
+  SlicedMesh pieces_in_input = *model_pieces;
+  pieces_in_input.mesh.V = to_input(model_pieces->mesh.V);
+  write_pieces(pieces_path, pieces_in_input);
   outputs.push_back(pieces_path);
   const std::string preview_path = (dir / "preview.png").string();
   if (map)
-    write_map_preview(preview_path, prepared.mesh, polycube->polycube, *map);
+    write_map_preview(preview_path, model, polycube->polycube, *map);
   else if (polycube)
     write_polycube_preview(preview_path, *polycube);
   else
@@ -273,6 +313,11 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "About how many vertices the triangulated polycube gets (0: as many as the model)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  command->add_option("--align", options->align,
+                      "auto: try the input frame and the principal axes, each axis as the sweep direction, keep the polycube with the "
+                      "fewest corners; none: keep the input's orientation")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "none"}));
   command->add_option("--stage", options->stage, "Stop after this stage")
       ->capture_default_str()
       ->check(CLI::IsMember(kStages));

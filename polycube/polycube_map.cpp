@@ -368,6 +368,9 @@ PolycubeMap build_polycube_map(const TriMesh& model, const PolycubeResult& resul
   const int n_pairs = static_cast<int>(ms.pieces.size());
   if (static_cast<int>(result.piece_match.size()) != n_pairs) throw std::invalid_argument("build_polycube_map: piece_match does not match the model's pieces");
 
+  for (int f = 0; f < ms.mesh.num_faces(); ++f)
+    if (ms.face_origin[f] < 0 || ms.face_origin[f] >= model.num_faces())
+      throw AlgorithmError("the topology stage split a degenerate saddle (the model moved there); the map does not support this yet");
   auto data = std::make_shared<PolycubeMapData>();
   data->model = model;
   data->polycube = result.polycube.mesh;

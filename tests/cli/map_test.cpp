@@ -5,6 +5,8 @@
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
+
+#include <Eigen/LU>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -54,7 +56,7 @@ TEST(MapCli, TopologyStageWritesReportAndPieces) {
 TEST(MapCli, PolycubeStageWritesAValidAxisAlignedPolycubeOfTheSameGenus) {
   const std::string dir = test::temp_dir("map-polycube");
   const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("rotor.off")) + " -o " + quoted(dir) +
-                                  " --stage polycube");
+                                  " --stage polycube --align none");
   ASSERT_EQ(run.code, 0) << run.err;
   const auto report = read_json(dir + "/report.json");
   const PreparedMesh cube = prepare_mesh(read_polygon_soup(dir + "/polycube.obj"));
@@ -71,6 +73,41 @@ TEST(MapCli, PolycubeStageWritesAValidAxisAlignedPolycubeOfTheSameGenus) {
   }
   EXPECT_GT(signed_volume(cube.mesh), 0);
   EXPECT_NO_THROW(read_image(dir + "/preview.png"));
+}
+
+// The whole map with --align auto: the chosen rotation is proper and orthonormal, P (written in
+// the input's frame) is axis-aligned once turned by it, and both image files have the counts of
+// the meshes they come from, their vertices on the other surface.
+TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
+  const std::string dir = test::temp_dir("map-full");
+  const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("knot.off")) + " -o " + quoted(dir));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  Eigen::Matrix3d R;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = report.at("alignment").at("rotation").at(i).at(j).get<double>();
+  EXPECT_LT((R * R.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-9);
+  EXPECT_NEAR(R.determinant(), 1.0, 1e-9);
+  EXPECT_EQ(report.at("alignment").at("candidates").size(), 6u);
+
+  const PolygonSoup cube = read_polygon_soup(dir + "/polycube.obj");
+  const PolygonSoup on_model = read_polygon_soup(dir + "/polycube_on_model.obj");
+  const PolygonSoup model = read_polygon_soup(test::data_path("knot.off"));
+  const PolygonSoup on_cube = read_polygon_soup(dir + "/model_on_polycube.obj");
+  EXPECT_EQ(on_model.points.size(), cube.points.size());
+  EXPECT_EQ(on_model.polygons, cube.polygons);
+  EXPECT_EQ(on_cube.points.size(), model.points.size());
+  // P turned into the chosen frame is axis-aligned.
+  const PreparedMesh p = prepare_mesh(cube);
+  TriMesh turned = p.mesh;
+  turned.V = p.mesh.V * R.transpose();
+  const Eigen::MatrixX3d normals = face_normals(turned);
+  int tilted = 0;
+  for (int f = 0; f < turned.num_faces(); ++f) tilted += normals.row(f).cwiseAbs().maxCoeff() < 1 - 1e-9;
+  EXPECT_EQ(tilted, 0);
+  EXPECT_EQ(report.at("map").at("flipped_disk_triangles").get<int>(), 0);
+  EXPECT_LT(report.at("map").at("polycube_to_model").at("max_distance").get<double>(), 1e-9);
+  EXPECT_LT(report.at("map").at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
 }
 
 TEST(MapCli, QuietRunPrintsNothing) {

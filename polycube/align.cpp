@@ -1,0 +1,109 @@
+#include "polycube/align.h"
+
+#include "polycube/errors.h"
+#include "polycube/parallel.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <chrono>
+#include <mutex>
+#include <numeric>
+
+namespace polycube {
+
+Eigen::Matrix3d principal_axes(const TriMesh& mesh) {
+  // Second moments of the surface, each triangle integrated exactly (vertices and centroid rule).
+  double area_sum = 0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    area_sum += area;
+    mean += area * (a + b + c) / 3;
+    // ∫ x x^T over a triangle = A/12 (sum x_i x_i^T + (sum x_i)(sum x_i)^T)
+    const Eigen::Vector3d s = a + b + c;
+    second += area / 12 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+  }
+  if (!(area_sum > 0)) return Eigen::Matrix3d::Identity();
+  mean /= area_sum;
+  const Eigen::Matrix3d covariance = second / area_sum - mean * mean.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  Eigen::Matrix3d axes;
+  for (int i = 0; i < 3; ++i) axes.row(i) = solver.eigenvectors().col(2 - i).transpose();  // largest first
+  if (axes.determinant() < 0) axes.row(2) *= -1;
+  // Axes within 5 degrees of the coordinate axes are the coordinate axes: a model already aligned
+  // (up to noise) must not be tilted by a hair, which would put its flat faces almost on planes.
+  Eigen::Matrix3d snapped = Eigen::Matrix3d::Zero();
+  bool near = true;
+  for (int i = 0; i < 3 && near; ++i) {
+    Eigen::Index k;
+    const double c = axes.row(i).cwiseAbs().maxCoeff(&k);
+    near = c > std::cos(5.0 * 3.14159265358979 / 180);
+    snapped(i, k) = axes(i, k) > 0 ? 1 : -1;
+  }
+  if (near && std::abs(snapped.determinant() - 1) < 1e-12) return snapped;
+  return axes;
+}
+
+TriMesh rotated(const TriMesh& mesh, const Eigen::Matrix3d& rotation) {
+  TriMesh out = mesh;
+  out.V = mesh.V * rotation.transpose();
+  return out;
+}
+
+Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology, const PolycubeOptions& polycube,
+                           const AlignmentOptions& options) {
+  Alignment out;
+  const Eigen::Matrix3d pca = principal_axes(mesh);
+  // Cyclic permutations keep the handedness: which frame axis becomes z.
+  const Eigen::Matrix3d cycles[3] = {Eigen::Matrix3d::Identity(),
+                                     (Eigen::Matrix3d() << 0, 1, 0, 0, 0, 1, 1, 0, 0).finished(),
+                                     (Eigen::Matrix3d() << 0, 0, 1, 1, 0, 0, 0, 1, 0).finished()};
+  const char* input_names[3] = {"input frame, z up", "input frame, x up", "input frame, y up"};
+  const char* principal_names[3] = {"principal axes, least-spread axis up", "principal axes, longest axis up",
+                                    "principal axes, middle axis up"};
+  for (int frame = 0; frame < 2; ++frame)
+    for (int k = 0; k < 3; ++k) {
+      AlignmentCandidate c;
+      c.name = frame == 0 ? input_names[k] : principal_names[k];
+      c.rotation = cycles[k] * (frame == 0 ? Eigen::Matrix3d::Identity() : pca);
+      out.candidates.push_back(c);
+    }
+  PolycubeOptions scoring = polycube;
+  scoring.max_rounds = std::min(scoring.max_rounds, options.max_rounds);
+  scoring.max_inserted_planes = std::min(scoring.max_inserted_planes, options.max_inserted_planes);
+  scoring.max_plane_cells = std::min(scoring.max_plane_cells, options.max_plane_cells);
+  scoring.max_repair_level = std::min(scoring.max_repair_level, options.max_repair_level);
+  std::mutex lock;
+  std::vector<int> order(out.candidates.size());
+  std::iota(order.begin(), order.end(), 0);
+  parallel_for_each(order, options.threads, "orientation", [&](int i) {
+    AlignmentCandidate& c = out.candidates[i];
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      const TriMesh turned = rotated(mesh, c.rotation);
+      auto t = std::make_shared<TopologyResult>(analyse_topology(turned, topology));
+      auto p = std::make_shared<PolycubeResult>(build_polycube(turned, *t, scoring));
+      c.corners = static_cast<int>(p->polycube.corners.size());
+      const std::lock_guard<std::mutex> guard(lock);
+      const bool better = out.chosen < 0 || c.corners < out.candidates[out.chosen].corners ||
+                          (c.corners == out.candidates[out.chosen].corners && i < out.chosen);
+      if (better) {
+        out.chosen = i;
+        out.topology = std::move(t);
+        out.polycube = std::move(p);
+      }
+    } catch (const Error& e) {
+      c.error = e.what();
+    }
+    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  });
+  if (out.chosen >= 0) out.rotation = out.candidates[out.chosen].rotation;
+  return out;
+}
+
+}  // namespace polycube

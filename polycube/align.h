@@ -1,0 +1,63 @@
+// Auto-orientation (the paper's limitation 1: its polycube depends on how the model is turned).
+// Candidates are the input frame and the model's principal axes, each with each of its three axes
+// as the sweep direction z; each is scored by building the polycube, and the one with the fewest
+// corners wins.
+#pragma once
+
+#include "polycube/mesh.h"
+#include "polycube/polycube_build.h"
+#include "polycube/topology.h"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace polycube {
+
+// One orientation tried: x_aligned = rotation * x_input (a proper rotation).
+//   corners  of the polycube built in it (-1 if the stages failed there, see error)
+struct AlignmentCandidate {
+  std::string name;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  int corners = -1;
+  double seconds = 0;
+  std::string error;
+};
+
+//   chosen     index of the winner, -1 if every candidate failed within the scoring budget
+//   topology, polycube  the winner's stages (built on the turned model), so they need not be redone
+struct Alignment {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  int chosen = -1;
+  std::vector<AlignmentCandidate> candidates;
+  std::shared_ptr<TopologyResult> topology;
+  std::shared_ptr<PolycubeResult> polycube;
+};
+
+// Principal axes of the surface (area-weighted covariance of the triangles), as the rows of a
+// proper rotation, largest variance first.
+Eigen::Matrix3d principal_axes(const TriMesh& mesh);
+
+// The mesh turned by `rotation` about the origin (V * rotation^T).
+TriMesh rotated(const TriMesh& mesh, const Eigen::Matrix3d& rotation);
+
+// The scoring budget: each candidate's polycube is built with the caller's options capped by these,
+// so that an orientation needing heavy repairs fails in a fraction of a second instead of being
+// scored (it would give many corners anyway).
+struct AlignmentOptions {
+  int threads = 0;  // candidates in parallel; 0: all cores
+  int max_rounds = 12;
+  int max_inserted_planes = 30;
+  int max_plane_cells = 4000;
+  int max_repair_level = 12;
+};
+
+// Scores the six candidates (input frame / principal axes × which axis is z) by the corner count
+// of the polycube built with the options (capped by the budget), fewest first; ties keep the
+// earlier candidate (the input frame first).
+Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology, const PolycubeOptions& polycube,
+                           const AlignmentOptions& options = {});
+
+}  // namespace polycube
