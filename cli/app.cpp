@@ -44,6 +44,7 @@ int run(int argc, char** argv) {
   CommandRunner runner;
   add_inspect_command(app, global, runner);
   add_map_command(app, global, runner);
+  add_quad_command(app, global, runner);
 
   // CLI11 would say "A subcommand is required" for a mistyped command; name it instead.
   if (argc > 1 && argv[1][0] != '-' && app.get_subcommands([&](const CLI::App* c) { return c->get_name() == argv[1]; }).empty())

@@ -43,6 +43,7 @@ class Progress {
 using CommandRunner = std::function<int()>;
 void add_inspect_command(CLI::App& app, const GlobalOptions& global, CommandRunner& runner);
 void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& runner);
+void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner& runner);
 
 // Parses argv, runs the chosen subcommand, prints one-line errors, returns the exit code.
 int run(int argc, char** argv);

@@ -1,0 +1,87 @@
+#include "applications/quad/quad_quality.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+namespace polycube {
+
+namespace {
+constexpr double kDegrees = 57.29577951308232;
+}  // namespace
+
+Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const Eigen::Vector3d corners[4]) {
+  return surface.face_normal(surface.closest((corners[0] + corners[1] + corners[2] + corners[3]) / 4).face);
+}
+
+QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& reference, const std::vector<int>& corners,
+                          const QuadQualityOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  QuadQuality r;
+  r.quads = quads.num_quads();
+  r.vertices = quads.num_vertices();
+  r.topology = quad_topology(quads);
+  if (r.topology.closed_manifold() && r.topology.components == 1) r.genus = r.topology.genus();
+  r.diagonal = bounding_box(reference.surface().V).diagonal();
+
+  const std::set<int> corner_set(corners.begin(), corners.end());
+  for (int v = 0; v < r.vertices; ++v) {
+    const bool irregular = r.topology.valence[v] != 4 && r.topology.valence[v] != 0;
+    r.irregular_vertices += irregular;
+    if (irregular && corner_set.count(v)) ++r.irregular_at_corners;
+  }
+  for (int c : corner_set) r.corners_irregular += c >= 0 && c < r.vertices && r.topology.valence[c] != 4;
+
+  std::vector<double> deviation;
+  deviation.reserve(4 * r.quads);
+  const double min_length = options.degenerate_tolerance * r.diagonal;
+  const double min_area = options.degenerate_tolerance * r.diagonal * r.diagonal;
+  double aspect_sum = 0;
+  for (int v = 0; v < r.vertices; ++v)
+    if (r.topology.valence[v] > 0)
+      r.max_distance_to_surface = std::max(r.max_distance_to_surface, reference.closest(quads.V.row(v).transpose()).distance);
+  for (int q = 0; q < r.quads; ++q) {
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = quads.V.row(quads.Q(q, k));
+    const Eigen::Vector3d normal = quad_surface_normal(reference, p);
+    const Eigen::Vector3d diagonal_cross = (p[2] - p[0]).cross(p[3] - p[1]);
+    if (diagonal_cross.dot(normal) <= 0) ++r.flipped_quads;
+    double shortest = INFINITY, longest = 0;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d next = p[(k + 1) % 4] - p[k], previous = p[(k + 3) % 4] - p[k];
+      shortest = std::min(shortest, next.norm());
+      longest = std::max(longest, next.norm());
+      const double angle = std::atan2(next.cross(previous).norm(), next.dot(previous)) * kDegrees;
+      deviation.push_back(std::abs(angle - 90));
+      if (next.cross(previous).dot(normal) <= 0) ++r.inverted_corners;
+    }
+    if (shortest <= min_length || diagonal_cross.norm() / 2 <= min_area) ++r.degenerate_quads;
+    const double aspect = shortest > 0 ? longest / shortest : INFINITY;
+    aspect_sum += aspect;
+    r.aspect_ratio_max = std::max(r.aspect_ratio_max, aspect);
+  }
+  if (!deviation.empty()) {
+    double sum = 0;
+    for (double d : deviation) sum += d;
+    r.angle_deviation_mean = sum / deviation.size();
+    r.aspect_ratio_mean = aspect_sum / r.quads;
+    const size_t k95 = std::min(deviation.size() - 1, static_cast<size_t>(std::ceil(0.95 * deviation.size())) - 1);
+    std::nth_element(deviation.begin(), deviation.begin() + k95, deviation.end());
+    r.angle_deviation_p95 = deviation[k95];
+    r.angle_deviation_max = *std::max_element(deviation.begin(), deviation.end());
+  }
+
+  if (options.hausdorff && r.quads > 0) {
+    const HausdorffDistance d = hausdorff_distance(triangulate_quads(quads), reference.surface(), options.sampling);
+    r.hausdorff_measured = true;
+    r.hausdorff = d.hausdorff;
+    r.hausdorff_percent = r.diagonal > 0 ? 100 * d.hausdorff / r.diagonal : 0;
+  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace polycube

@@ -1,0 +1,73 @@
+// How good a quad remesh is (issue 7's report): topology, irregular vertices, right angles,
+// flipped or degenerate quads, and distance to the surface it stands for.
+#pragma once
+
+#include "applications/quad/quad_mesh.h"
+#include "applications/quad/surface_projector.h"
+#include "polycube/polycube_distance.h"
+
+#include <vector>
+
+namespace polycube {
+
+struct QuadQualityOptions {
+  // Measure the Hausdorff distance (sampling; the slowest part).
+  bool hausdorff = true;
+  HausdorffOptions sampling;
+  // A quad is degenerate when its area or an edge is below this times the reference's diagonal
+  // (squared for the area).
+  double degenerate_tolerance = 1e-10;
+};
+
+// Everything measured (angles in degrees, lengths in input units).
+//   quads, vertices; topology of the quads
+//   genus                   (2 - euler) / 2 of a closed connected result, else -1
+//   irregular_vertices      valence != 4
+//   irregular_at_corners    of those, how many are in the given corner list
+//   corners_irregular       corners given that are irregular (= corners count when the map keeps them)
+//   angle_deviation_*       |corner angle - 90°| over all quad corners: mean, 95th percentile, max
+//   aspect_ratio_*          longest / shortest edge per quad: mean, max
+//   flipped_quads           quads whose normal (cross product of the diagonals) points against
+//                           quad_surface_normal (the criterion smooth_quads keeps)
+//   inverted_corners        quad corners whose two edges turn against it (non-convex or folded
+//                           quads)
+//   degenerate_quads        zero area or zero-length edge
+//   max_distance_to_surface largest vertex distance to the reference surface
+//   hausdorff               sampled two-sided distance between the triangulated quads and the
+//                           reference (0 when not measured), hausdorff_percent of its diagonal
+//   diagonal                of the reference's bounding box
+struct QuadQuality {
+  int quads = 0;
+  int vertices = 0;
+  QuadTopology topology;
+  int genus = -1;
+  int irregular_vertices = 0;
+  int irregular_at_corners = 0;
+  int corners_irregular = 0;
+  double angle_deviation_mean = 0;
+  double angle_deviation_p95 = 0;
+  double angle_deviation_max = 0;
+  double aspect_ratio_mean = 0;
+  double aspect_ratio_max = 0;
+  int flipped_quads = 0;
+  int inverted_corners = 0;
+  int degenerate_quads = 0;
+  double max_distance_to_surface = 0;
+  bool hausdorff_measured = false;
+  double hausdorff = 0;
+  double hausdorff_percent = 0;
+  double diagonal = 0;
+  double seconds = 0;
+};
+
+// The surface's normal for a quad: that of the triangle closest to the quad's centre (a face
+// normal, so a quad on one face of a polycube gets exactly that face's normal).
+Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const Eigen::Vector3d corners[4]);
+
+// Measures quads against the surface they approximate.
+//   corners  vertex indices expected to be irregular (the polycube's corners), may be empty
+// Throws std::invalid_argument for a bad quad index.
+QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& reference, const std::vector<int>& corners,
+                          const QuadQualityOptions& options = {});
+
+}  // namespace polycube

@@ -1,0 +1,63 @@
+// The quad application in one call (issue 7): a conforming grid on the polycube P, carried to the
+// model M by a map P → M, optionally relaxed on M, and measured.
+//
+//   grid    = build_polycube_grid(P, φ)         quads on P, irregular only at P's corners,
+//                                               chords sized by their length on M
+//   quads   = carry_grid(grid, map)             the same quads on M
+//   quads   = smooth_quads(quads, M)            optional, never flips a quad
+//   quality = measure_quads(quads, M, corners)
+#pragma once
+
+#include "applications/quad/carry_grid.h"
+#include "applications/quad/polycube_grid.h"
+#include "applications/quad/quad_quality.h"
+#include "applications/quad/quad_smooth.h"
+#include "applications/quad/surface_projector.h"
+
+#include <functional>
+#include <string>
+
+namespace polycube {
+
+// Called when a step starts and when it ends: (stage, message). Stages: "grid", "carry",
+// "smooth", "quality".
+using QuadProgress = std::function<void(const std::string& stage, const std::string& message)>;
+
+struct QuadRemeshOptions {
+  PolycubeGridOptions grid;
+  // Size the grid's chords by their lengths on M (through to_model) rather than on P, so quads
+  // are near h wide on the model where φ stretches or shrinks P.
+  bool size_on_model = true;
+  CarryOptions carry;
+  QuadSmoothOptions smooth;
+  QuadQualityOptions quality;
+  bool measure = true;  // false: skip measure_quads
+};
+
+// Everything produced.
+//   grid       the grid on P (positions on P, vertices as points of P, corners)
+//   mesh       the quads on M (grid's connectivity)
+//   smoothing  what the relaxation did (nothing when options.smooth.sweeps is 0)
+//   quality    of mesh against M (quality.seconds: its time)
+//   seconds_*  wall time per stage
+struct QuadRemeshResult {
+  PolycubeGrid grid;
+  QuadMesh mesh;
+  QuadSmoothResult smoothing;
+  QuadQuality quality;
+  double seconds_grid = 0;
+  double seconds_carry = 0;
+  double seconds_smooth = 0;
+  double seconds_quality = 0;
+};
+
+// Runs the four steps.
+//   polycube  P's triangle mesh (SurfacePoint faces passed to `to_model` refer to it)
+//   to_model  φ: P → M, point by point
+//   model     M, as a projector (smoothing keeps vertices on it, quality measures against it)
+//   progress  optional
+// Throws what the steps throw.
+QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_model, const SurfaceProjector& model,
+                              const QuadRemeshOptions& options = {}, const QuadProgress& progress = {});
+
+}  // namespace polycube

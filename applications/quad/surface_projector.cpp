@@ -1,0 +1,111 @@
+#include "applications/quad/surface_projector.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <boost/iterator/counting_iterator.hpp>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace polycube {
+
+namespace {
+
+using Kernel = CGAL::Simple_cartesian<double>;
+using Point = Kernel::Point_3;
+using Triangle = Kernel::Triangle_3;
+
+// A triangle of the surface known by its face index.
+class FacePrimitive {
+ public:
+  using Id = int;
+  using Point = Kernel::Point_3;
+  using Datum = Kernel::Triangle_3;
+
+  FacePrimitive() = default;
+  FacePrimitive(boost::counting_iterator<int> face, const std::vector<Triangle>* triangles)
+      : face_(*face), triangles_(triangles) {}
+  Id id() const { return face_; }
+  const Datum& datum() const { return (*triangles_)[face_]; }
+  Point reference_point() const { return (*triangles_)[face_].vertex(0); }
+
+ private:
+  int face_ = -1;
+  const std::vector<Triangle>* triangles_ = nullptr;
+};
+
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, FacePrimitive>>;
+
+}  // namespace
+
+struct SurfaceProjector::Impl {
+  TriMesh surface;
+  Eigen::MatrixX3d normals;
+  Eigen::MatrixX3d vertex_normals;
+  std::vector<Triangle> triangles;
+  Tree tree;
+};
+
+SurfaceProjector::SurfaceProjector(const TriMesh& surface) : impl_(std::make_unique<Impl>()) {
+  if (surface.num_faces() == 0) throw std::invalid_argument("cannot project onto a mesh without faces");
+  impl_->surface = surface;
+  impl_->normals = face_normals(surface);
+  impl_->vertex_normals = Eigen::MatrixX3d::Zero(surface.num_vertices(), 3);
+  for (int f = 0; f < surface.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d p = surface.V.row(surface.F(f, i));
+      const Eigen::Vector3d u = surface.V.row(surface.F(f, (i + 1) % 3)).transpose() - p;
+      const Eigen::Vector3d w = surface.V.row(surface.F(f, (i + 2) % 3)).transpose() - p;
+      const double angle = std::atan2(u.cross(w).norm(), u.dot(w));
+      impl_->vertex_normals.row(surface.F(f, i)) += angle * impl_->normals.row(f);
+    }
+  for (int v = 0; v < surface.num_vertices(); ++v) {
+    const double length = impl_->vertex_normals.row(v).norm();
+    if (length > 0) impl_->vertex_normals.row(v) /= length;
+  }
+  const auto point = [&](int v) { return Point(surface.V(v, 0), surface.V(v, 1), surface.V(v, 2)); };
+  impl_->triangles.reserve(surface.num_faces());
+  for (int f = 0; f < surface.num_faces(); ++f)
+    impl_->triangles.emplace_back(point(surface.F(f, 0)), point(surface.F(f, 1)), point(surface.F(f, 2)));
+  impl_->tree.insert(boost::counting_iterator<int>(0), boost::counting_iterator<int>(surface.num_faces()), &impl_->triangles);
+  impl_->tree.build();
+  impl_->tree.accelerate_distance_queries();
+}
+
+SurfaceProjector::~SurfaceProjector() = default;
+
+SurfaceHit SurfaceProjector::closest(const Eigen::Vector3d& query) const {
+  const Point q(query.x(), query.y(), query.z());
+  const auto [point, face] = impl_->tree.closest_point_and_primitive(q);
+  SurfaceHit hit;
+  hit.point = {point.x(), point.y(), point.z()};
+  hit.face = face;
+  hit.distance = (hit.point - query).norm();
+  // Barycentric coordinates of the point in its triangle (areas of the opposite sub-triangles).
+  const TriMesh& m = impl_->surface;
+  const Eigen::Vector3d a = m.V.row(m.F(face, 0)), b = m.V.row(m.F(face, 1)), c = m.V.row(m.F(face, 2));
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double area = n.squaredNorm();
+  if (area > 0) {
+    const double wa = std::max(0.0, (c - b).cross(hit.point - b).dot(n) / area);
+    const double wb = std::max(0.0, (a - c).cross(hit.point - c).dot(n) / area);
+    const double wc = std::max(0.0, (b - a).cross(hit.point - a).dot(n) / area);
+    hit.normal = wa * impl_->vertex_normals.row(m.F(face, 0)) + wb * impl_->vertex_normals.row(m.F(face, 1)) +
+                 wc * impl_->vertex_normals.row(m.F(face, 2));
+  }
+  const double length = hit.normal.norm();
+  hit.normal = length > 1e-12 ? (hit.normal / length).eval() : impl_->normals.row(face).transpose().eval();
+  return hit;
+}
+
+const TriMesh& SurfaceProjector::surface() const { return impl_->surface; }
+
+Eigen::Vector3d SurfaceProjector::face_normal(int f) const { return impl_->normals.row(f); }
+
+}  // namespace polycube

@@ -1,0 +1,48 @@
+// Closest points on a triangle mesh (CGAL AABB tree behind this wrapper): places carried grid
+// vertices on the model and keeps relaxed vertices on it.
+#pragma once
+
+#include "polycube/mesh.h"
+
+#include <Eigen/Core>
+
+#include <memory>
+
+namespace polycube {
+
+// The closest point of the surface to a query.
+//   point     on the surface
+//   face      triangle of the surface holding it
+//   distance  from the query
+//   normal    unit surface normal there, interpolated from the angle-weighted vertex normals of the
+//             triangle (continuous across edges, so a point on a crease gets the mean direction
+//             of the faces meeting there instead of one face's normal)
+struct SurfaceHit {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  int face = -1;
+  double distance = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+};
+
+// Precomputes the search tree once; queries are const and may run on several threads. Keeps its
+// own copy of the surface.
+class SurfaceProjector {
+ public:
+  // Throws std::invalid_argument for a mesh without faces.
+  explicit SurfaceProjector(const TriMesh& surface);
+  ~SurfaceProjector();
+  SurfaceProjector(const SurfaceProjector&) = delete;
+  SurfaceProjector& operator=(const SurfaceProjector&) = delete;
+
+  SurfaceHit closest(const Eigen::Vector3d& query) const;
+
+  const TriMesh& surface() const;
+  // Unit outward normal of triangle f (zero for a degenerate one).
+  Eigen::Vector3d face_normal(int f) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace polycube

@@ -1,0 +1,272 @@
+// `polycube quad FILE -o OUT.{obj,ply,off}`: an all-quad remesh of the model from its polycube
+// map (issue 7): a conforming grid on P carried to M, irregular only at P's corners.
+#include "cli/commands.h"
+#include "cli/mesh_input.h"
+
+#include "applications/quad/quad_remesh.h"
+#include "formats/atomic_file.h"
+#include "formats/mesh_io.h"
+#include "polycube/align.h"
+#include "polycube/errors.h"
+#include "polycube/polycube_build.h"
+#include "polycube/polycube_map.h"
+#include "polycube/topology.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace polycube::cli {
+
+namespace {
+
+struct QuadCommandOptions {
+  MeshInput input;
+  std::string output;
+  int target_faces = 10000;
+  double cell_size = 0;
+  std::string map_dir;
+  int smooth = 0;
+  std::string report_path;
+  std::string align = "auto";
+  TopologyOptions topology;
+  PolycubeOptions polycube;
+};
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+std::string percent(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", x);
+  return text;
+}
+
+// A triangle mesh file written by `polycube map` (no validation: it is ours).
+TriMesh read_triangles(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw InputError(path + ": no such file (run `polycube map FILE -o DIR` first)");
+  const PolygonSoup soup = read_polygon_soup(path);
+  TriMesh mesh;
+  mesh.V.resize(static_cast<Eigen::Index>(soup.points.size()), 3);
+  for (size_t v = 0; v < soup.points.size(); ++v) mesh.V.row(static_cast<Eigen::Index>(v)) = soup.points[v];
+  mesh.F.resize(static_cast<Eigen::Index>(soup.polygons.size()), 3);
+  for (size_t f = 0; f < soup.polygons.size(); ++f) {
+    if (soup.polygons[f].size() != 3)
+      throw InputError(path + ": face " + std::to_string(f) + " has " + std::to_string(soup.polygons[f].size()) +
+                       " corners, expected triangles");
+    for (int i = 0; i < 3; ++i) mesh.F(static_cast<Eigen::Index>(f), i) = soup.polygons[f][i];
+  }
+  return mesh;
+}
+
+// The map from a `polycube map` directory: P (polycube.obj) and φ at P's vertices
+// (polycube_on_model.obj, same triangles), interpolated in P's triangles and placed on M.
+struct MapFromDirectory {
+  TriMesh polycube;
+  SurfaceMap to_model;
+};
+
+MapFromDirectory read_map_directory(const std::string& dir, const std::shared_ptr<const SurfaceProjector>& model,
+                                    const Progress& progress) {
+  const std::filesystem::path d(dir);
+  if (!std::filesystem::is_directory(d)) throw InputError(dir + ": not a directory");
+  MapFromDirectory map;
+  map.polycube = read_triangles((d / "polycube.obj").string());
+  const TriMesh on_model = read_triangles((d / "polycube_on_model.obj").string());
+  if (on_model.V.rows() != map.polycube.V.rows() || on_model.F != map.polycube.F)
+    throw InputError(dir + ": polycube_on_model.obj (" + std::to_string(on_model.V.rows()) +
+                     " vertices) does not have polycube.obj's triangles (" + std::to_string(map.polycube.V.rows()) +
+                     " vertices)");
+  // The images must lie on this model: a map directory of another mesh would give garbage.
+  const double diagonal = bounding_box(model->surface().V).diagonal();
+  double farthest = 0;
+  for (int v = 0; v < on_model.num_vertices(); ++v)
+    farthest = std::max(farthest, model->closest(on_model.V.row(v).transpose()).distance);
+  if (farthest > 0.01 * diagonal)
+    throw InputError(dir + ": the map does not belong to this model (its images are up to " +
+                     percent(100 * farthest / diagonal) + " % of the diagonal away from the surface)");
+  if (farthest > 1e-6 * diagonal)
+    progress.warning("map images are up to " + percent(100 * farthest / diagonal) +
+                     " % of the diagonal off the model; projected onto it");
+  map.to_model = projected_map(vertex_image_map(map.polycube, on_model.V), model);
+  return map;
+}
+
+nlohmann::json quality_json(const QuadQuality& q) {
+  return {{"quads", q.quads},
+          {"vertices", q.vertices},
+          {"edges", q.topology.edges},
+          {"euler", q.topology.euler},
+          {"genus", q.genus >= 0 ? nlohmann::json(q.genus) : nlohmann::json()},
+          {"closed_manifold", q.topology.closed_manifold()},
+          {"components", q.topology.components},
+          {"irregular_vertices", q.irregular_vertices},
+          {"irregular_at_corners", q.irregular_at_corners},
+          {"angle_deviation_degrees", {{"mean", q.angle_deviation_mean}, {"p95", q.angle_deviation_p95}, {"max", q.angle_deviation_max}}},
+          {"aspect_ratio", {{"mean", q.aspect_ratio_mean}, {"max", q.aspect_ratio_max}}},
+          {"flipped_quads", q.flipped_quads},
+          {"inverted_corners", q.inverted_corners},
+          {"degenerate_quads", q.degenerate_quads},
+          {"max_vertex_distance", q.max_distance_to_surface},
+          {"hausdorff", q.hausdorff_measured ? nlohmann::json(q.hausdorff) : nlohmann::json()},
+          {"hausdorff_percent_diagonal", q.hausdorff_measured ? nlohmann::json(q.hausdorff_percent) : nlohmann::json()},
+          {"diagonal", q.diagonal}};
+}
+
+int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
+  const Progress progress(global);
+  // Fail before the long stages when the outputs cannot go where asked.
+  for (const std::string& path : {options.output, options.report_path}) {
+    if (path.empty()) continue;
+    const std::filesystem::path parent = std::filesystem::absolute(path).parent_path();
+    if (!std::filesystem::is_directory(parent)) throw OutputError("cannot write " + path + ": no directory " + parent.string());
+  }
+  const PreparedMesh prepared = load_mesh(options.input, progress);
+  require_mappable(prepared.diagnosis);
+  const TriMesh& model = prepared.mesh;
+  const auto projector = std::make_shared<const SurfaceProjector>(model);
+
+  nlohmann::json report;
+  report["input"] = diagnosis_json(prepared);
+  report["input"]["file"] = options.input.path;
+  report["parameters"] = {{"target_faces", options.cell_size > 0 ? nlohmann::json() : nlohmann::json(options.target_faces)},
+                          {"cell_size", options.cell_size > 0 ? nlohmann::json(options.cell_size) : nlohmann::json()},
+                          {"smooth", options.smooth},
+                          {"map", options.map_dir.empty() ? nlohmann::json() : nlohmann::json(options.map_dir)}};
+  nlohmann::json seconds;
+
+  // The map P → M: from the directory, or built now.
+  const TriMesh* polycube_mesh = nullptr;
+  SurfaceMap to_model;
+  std::optional<MapFromDirectory> from_directory;
+  std::optional<PolycubeResult> polycube;
+  std::optional<PolycubeMap> map;
+  TriMesh aligned;
+  QuadRemeshOptions remesh;
+  if (!options.map_dir.empty()) {
+    progress.stage("map", "reading " + options.map_dir);
+    from_directory = read_map_directory(options.map_dir, projector, progress);
+    polycube_mesh = &from_directory->polycube;
+    to_model = from_directory->to_model;
+    remesh.carry.threads = 0;  // interpolation and closest points are thread-safe
+  } else {
+    report["parameters"]["dz"] = options.topology.dz;
+    report["parameters"]["da"] = options.polycube.da;
+    // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
+    // images are turned back into the input's frame.
+    Alignment alignment;
+    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    if (options.align == "auto") {
+      progress.stage("align", "scoring 6 orientations (input frame, principal axes) by polycube corners");
+      alignment = choose_alignment(model, options.topology, options.polycube);
+      if (alignment.chosen >= 0) {
+        rotation = alignment.rotation;
+        progress.stage("align", alignment.candidates[alignment.chosen].name);
+      }
+    }
+    report["parameters"]["align"] = options.align;
+    aligned = rotated(model, rotation);
+    progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
+    const TopologyResult topology = alignment.topology ? std::move(*alignment.topology) : analyse_topology(aligned, options.topology);
+    seconds["topology"] = topology.seconds_total;
+    progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
+    polycube = alignment.polycube ? std::move(*alignment.polycube) : build_polycube(aligned, topology, options.polycube);
+    for (const std::string& repair : polycube->repairs) progress.warning("polycube: " + repair);
+    seconds["polycube"] = polycube->seconds_total;
+    progress.stage("polycube", std::to_string(polycube->polycube.corners.size()) + " corners, " +
+                                   std::to_string(polycube->polycube.faces.size()) + " faces");
+    progress.stage("map", "bijection between the polycube and the model");
+    map = build_polycube_map(aligned, *polycube);
+    seconds["map"] = map->seconds;
+    polycube_mesh = &polycube->polycube.mesh;
+    to_model = [&aligned, &map, rotation](const SurfacePoint& p) -> Eigen::Vector3d {
+      return rotation.transpose() * surface_position(aligned, map->to_model(p));
+    };
+    remesh.carry.threads = 0;  // PolycubeMap::to_model only reads
+  }
+
+  remesh.grid.cell_size = options.cell_size;
+  remesh.grid.target_quads = options.target_faces;
+  remesh.smooth.sweeps = options.smooth;
+  const QuadRemeshResult result =
+      remesh_quads(*polycube_mesh, to_model, *projector, remesh,
+                   [&progress](const std::string& stage, const std::string& message) { progress.stage(stage, message); });
+  const QuadQuality& q = result.quality;
+  if (q.flipped_quads > 0) progress.warning(std::to_string(q.flipped_quads) + " quads are flipped on the model");
+  if (q.degenerate_quads > 0) progress.warning(std::to_string(q.degenerate_quads) + " quads are degenerate");
+
+  write_polygon_mesh(options.output, result.mesh.V, quad_polygons(result.mesh));
+  seconds["grid"] = result.seconds_grid;
+  seconds["carry"] = result.seconds_carry;
+  seconds["smooth"] = result.seconds_smooth;
+  seconds["quality"] = result.seconds_quality;
+  seconds["total"] = progress.elapsed_seconds();
+  progress.stage("done", "wrote " + options.output);
+
+  if (!options.report_path.empty()) {
+    const PolycubeGrid& grid = result.grid;
+    report["grid"] = {{"quads", grid.mesh.num_quads()},
+                      {"vertices", grid.mesh.num_vertices()},
+                      {"corners", grid.corners.size()},
+                      {"cell_size", grid.cell_size},
+                      {"levels", {grid.levels[0].size(), grid.levels[1].size(), grid.levels[2].size()}},
+                      {"level_cells", grid.level_cells},
+                      {"free_loops_removed", grid.free_loops},
+                      {"layout_cells", grid.layout.num_quads()},
+                      {"chords", grid.chords}};
+    report["smoothing"] = {{"sweeps", result.smoothing.sweeps}, {"moves", result.smoothing.moves}, {"refused", result.smoothing.rejected}};
+    report["quality"] = quality_json(q);
+    report["seconds"] = seconds;
+    report["output"] = options.output;
+    write_text_atomically(options.report_path, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+  }
+  return kSuccess;
+}
+
+}  // namespace
+
+void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner& runner) {
+  auto options = std::make_shared<QuadCommandOptions>();
+  CLI::App* command = app.add_subcommand("quad", "All-quad remesh from the polycube map (irregular only at polycube corners)");
+  add_mesh_input_options(*command, options->input);
+  command->add_option("-o,--output", options->output, "Output quad mesh (.obj .ply .off)")
+      ->required()
+      ->check(CLI::Validator(
+          [](std::string& path) {
+            const std::string ext = lower_extension(path);
+            return ext == ".obj" || ext == ".ply" || ext == ".off" ? std::string()
+                                                                     : "output must end in .obj, .ply or .off: " + path;
+          },
+          "OUT.{obj,ply,off}"));
+  CLI::Option* target = command->add_option("--target-faces", options->target_faces, "About how many quads to make")
+                            ->capture_default_str()
+                            ->check(CLI::Range(1, 50'000'000));
+  CLI::Option* size = command->add_option("--cell-size", options->cell_size, "Quad size in input units (instead of --target-faces)")
+                          ->check(CLI::PositiveNumber);
+  target->excludes(size);
+  command->add_option("--map", options->map_dir, "Directory written by `polycube map` (reuses its map instead of building one)");
+  command->add_option("--smooth", options->smooth, "Tangential relaxation sweeps on the model (never flip a quad)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 10000));
+  command->add_option("--report", options->report_path, "Write the quality report as JSON to this file");
+  command->add_option("--align", options->align, "Orientation search as for `map` (auto | none; not with --map)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "none"}));
+  command->add_option("--dz", options->topology.dz, "Largest gap between cutting planes, unit-cube units (paper's d_z; not with --map)")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-3, 1.0));
+  command->add_option("--da", options->polycube.da, "Area tolerance of the axis-aligned contours (paper's d_a; not with --map)")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-3, 1.0));
+  command->callback([options, &global, &runner] { runner = [options, &global] { return run_quad(*options, global); }; });
+}
+
+}  // namespace polycube::cli

@@ -1,0 +1,242 @@
+// Carrying the grid from P to a surface with known maps: the identity onto P keeps perfect
+// squares; a smooth bijective deformation and the cube-to-sphere projection flip no quad; a
+// reflection flips every quad (the measure can fail). Vertex images interpolated and projected
+// land on the surface. Relaxation keeps vertices on the surface and never adds a flipped quad.
+#include "applications/quad/carry_grid.h"
+#include "applications/quad/polycube_grid.h"
+#include "applications/quad/quad_quality.h"
+#include "applications/quad/quad_remesh.h"
+#include "applications/quad/quad_smooth.h"
+#include "applications/quad/surface_projector.h"
+
+#include "polycube/errors.h"
+#include "polycube/polycube_build.h"
+#include "polycube/topology.h"
+#include "support/generated_meshes.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <memory>
+#include <random>
+#include <stdexcept>
+
+namespace polycube {
+namespace {
+
+// The polycube of a small real mesh (genus 2), built once.
+const PolycubeResult& eight_polycube() {
+  static const PolycubeResult result = [] {
+    const TriMesh model = test::load_test_mesh("eight.off");
+    return build_polycube(model, analyse_topology(model));
+  }();
+  return result;
+}
+
+// The cube [-1, 1]^3 as 12 triangles, outward.
+TriMesh cube() {
+  TriMesh mesh;
+  mesh.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i) mesh.V.row(i) << (i & 1 ? 1 : -1), (i & 2 ? 1 : -1), (i & 4 ? 1 : -1);
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  mesh.F.resize(12, 3);
+  for (int q = 0; q < 6; ++q) {
+    mesh.F.row(2 * q) << quads[q][0], quads[q][1], quads[q][2];
+    mesh.F.row(2 * q + 1) << quads[q][0], quads[q][2], quads[q][3];
+  }
+  return mesh;
+}
+
+Eigen::Vector3d on_mesh(const TriMesh& mesh, const SurfacePoint& p) {
+  return p.bary[0] * mesh.V.row(mesh.F(p.face, 0)).transpose() + p.bary[1] * mesh.V.row(mesh.F(p.face, 1)).transpose() +
+         p.bary[2] * mesh.V.row(mesh.F(p.face, 2)).transpose();
+}
+
+// A smooth bijection of space: the perturbation's Jacobian has norm <= 0.24 < 1.
+struct Deformation {
+  Eigen::Vector3d centre;
+  double size;
+  Eigen::Vector3d operator()(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d u = (p - centre) / size;
+    return p + 0.08 * size * Eigen::Vector3d(std::sin(3 * u.y()), std::sin(3 * u.z()), std::sin(3 * u.x()));
+  }
+};
+
+TEST(QuadCarry, IdentityOntoThePolycubeKeepsSquares) {
+  const TriMesh& P = eight_polycube().polycube.mesh;
+  PolycubeGridOptions options;
+  options.target_quads = 3000;
+  const PolycubeGrid grid = build_polycube_grid(P, options);
+  const QuadMesh quads = carry_grid(grid, [&](const SurfacePoint& p) { return on_mesh(P, p); });
+  EXPECT_EQ(quads.Q, grid.mesh.Q);
+  EXPECT_LE((quads.V - grid.mesh.V).cwiseAbs().maxCoeff(), 1e-12 * bounding_box(P.V).diagonal());
+
+  const SurfaceProjector surface(P);
+  const QuadQuality q = measure_quads(quads, surface, grid.corners);
+  EXPECT_EQ(q.quads, grid.mesh.num_quads());
+  EXPECT_EQ(q.genus, 2);
+  EXPECT_EQ(q.flipped_quads, 0);
+  EXPECT_EQ(q.inverted_corners, 0);
+  EXPECT_EQ(q.degenerate_quads, 0);
+  EXPECT_LE(q.angle_deviation_max, 1e-6);
+  EXPECT_EQ(q.irregular_vertices, static_cast<int>(grid.corners.size()));
+  EXPECT_EQ(q.irregular_at_corners, q.irregular_vertices);
+  EXPECT_EQ(q.corners_irregular, q.irregular_vertices);
+  EXPECT_GE(q.irregular_vertices, static_cast<int>(eight_polycube().polycube.corners.size()));
+  ASSERT_TRUE(q.hausdorff_measured);
+  EXPECT_LE(q.hausdorff_percent, 1e-9);
+  EXPECT_LE(q.max_distance_to_surface, 1e-12 * q.diagonal);
+}
+
+TEST(QuadCarry, SmoothBijectionFlipsNothing) {
+  const TriMesh& P = eight_polycube().polycube.mesh;
+  const BoundingBox box = bounding_box(P.V);
+  const Deformation deform{(box.min + box.max) / 2, box.diagonal()};
+  TriMesh M = P;
+  for (int v = 0; v < M.num_vertices(); ++v) M.V.row(v) = deform(P.V.row(v).transpose());
+  const auto surface = std::make_shared<const SurfaceProjector>(M);
+  PolycubeGridOptions options;
+  options.target_quads = 3000;
+  const PolycubeGrid grid = build_polycube_grid(P, options);
+
+  // The deformation itself, evaluated at the grid points (off M by the chord error of M).
+  const QuadMesh exact = carry_grid(grid, [&](const SurfacePoint& p) { return deform(on_mesh(P, p)); });
+  const QuadQuality e = measure_quads(exact, *surface, grid.corners);
+  EXPECT_EQ(e.flipped_quads, 0);
+  EXPECT_EQ(e.inverted_corners, 0);
+  EXPECT_EQ(e.degenerate_quads, 0);
+  EXPECT_GT(e.angle_deviation_max, 1) << "the deformation should shear the squares";
+  EXPECT_EQ(e.irregular_vertices, static_cast<int>(grid.corners.size()));
+
+  // Known at P's vertices only: interpolated inside P's triangles, then projected on M.
+  const SurfaceMap interpolated = vertex_image_map(P, M.V);
+  CarryOptions threads;
+  threads.threads = 2;
+  const QuadMesh linear = carry_grid(grid, interpolated, threads);
+  const QuadMesh projected = carry_grid(grid, projected_map(interpolated, surface));
+  const double diagonal = box.diagonal();
+  EXPECT_LE((linear.V - projected.V).cwiseAbs().maxCoeff(), 1e-9 * diagonal);
+  EXPECT_LE((linear.V - exact.V).rowwise().norm().maxCoeff(), 0.02 * diagonal);
+  const QuadQuality l = measure_quads(projected, *surface, grid.corners);
+  EXPECT_EQ(l.flipped_quads, 0);
+  EXPECT_EQ(l.degenerate_quads, 0);
+  EXPECT_LE(l.max_distance_to_surface, 1e-9 * diagonal);
+  EXPECT_LE(l.hausdorff_percent, 0.5);
+}
+
+TEST(QuadCarry, ReflectionFlipsEveryQuad) {
+  const TriMesh P = cube();
+  TriMesh M = P;
+  M.V.col(0) *= -1;
+  M.F.col(1).swap(M.F.col(2));  // outward again
+  PolycubeGridOptions options;
+  options.target_quads = 600;
+  const PolycubeGrid grid = build_polycube_grid(P, options);
+  const QuadMesh quads = carry_grid(grid, [&](const SurfacePoint& p) {
+    Eigen::Vector3d x = on_mesh(P, p);
+    x.x() *= -1;
+    return x;
+  });
+  const QuadQuality q = measure_quads(quads, SurfaceProjector(M), grid.corners);
+  EXPECT_EQ(q.flipped_quads, q.quads);
+  EXPECT_EQ(q.inverted_corners, 4 * q.quads);
+}
+
+TEST(QuadCarry, NonFiniteImageIsAnError) {
+  const PolycubeGrid grid = build_polycube_grid(cube(), {});
+  EXPECT_THROW(carry_grid(grid, [](const SurfacePoint&) { return Eigen::Vector3d(NAN, 0, 0); }), AlgorithmError);
+  EXPECT_THROW(vertex_image_map(cube(), Eigen::MatrixX3d::Zero(3, 3)), std::invalid_argument);
+}
+
+// The cube carried onto a sphere by central projection: 8 irregular vertices of valence 3.
+struct CubeSphere {
+  PolycubeGrid grid;
+  std::shared_ptr<const SurfaceProjector> sphere;
+  QuadMesh quads;
+};
+
+CubeSphere cube_sphere(int target) {
+  CubeSphere c;
+  PolycubeGridOptions options;
+  options.target_quads = target;
+  c.grid = build_polycube_grid(cube(), options);
+  c.sphere = std::make_shared<const SurfaceProjector>(test::make_sphere(4));
+  const TriMesh P = cube();
+  c.quads = carry_grid(c.grid, projected_map([P](const SurfacePoint& p) { return on_mesh(P, p).normalized().eval(); }, c.sphere));
+  return c;
+}
+
+TEST(QuadCarry, CubeOntoSphereAndRelaxation) {
+  const CubeSphere c = cube_sphere(1500);
+  const QuadQuality before = measure_quads(c.quads, *c.sphere, c.grid.corners);
+  EXPECT_EQ(before.irregular_vertices, 8);
+  EXPECT_EQ(before.irregular_at_corners, 8);
+  EXPECT_EQ(before.genus, 0);
+  EXPECT_EQ(before.flipped_quads, 0);
+  EXPECT_EQ(before.inverted_corners, 0);
+  EXPECT_LE(before.max_distance_to_surface, 1e-12);
+
+  QuadSmoothOptions options;
+  options.sweeps = 10;
+  const QuadSmoothResult smoothed = smooth_quads(c.quads, *c.sphere, options);
+  EXPECT_EQ(smoothed.sweeps, 10);
+  EXPECT_GT(smoothed.moves, 0);
+  EXPECT_EQ(smoothed.mesh.Q, c.quads.Q);
+  const QuadQuality after = measure_quads(smoothed.mesh, *c.sphere, c.grid.corners);
+  EXPECT_EQ(after.flipped_quads, 0);
+  EXPECT_EQ(after.inverted_corners, 0);
+  EXPECT_EQ(after.degenerate_quads, 0);
+  EXPECT_LE(after.max_distance_to_surface, 1e-12);
+  EXPECT_LT(after.aspect_ratio_max, before.aspect_ratio_max) << "relaxation evens out the sizes";
+  EXPECT_EQ(after.irregular_vertices, 8);
+}
+
+TEST(QuadCarry, RelaxationNeverAddsAFlippedQuad) {
+  CubeSphere c = cube_sphere(1500);
+  // Shake every vertex along the sphere by up to a cell: many quads fold.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> shake(-0.12, 0.12);
+  for (int v = 0; v < c.quads.num_vertices(); ++v) {
+    const Eigen::Vector3d p = c.quads.V.row(v);
+    c.quads.V.row(v) = c.sphere->closest(p + Eigen::Vector3d(shake(random), shake(random), shake(random))).point;
+  }
+  const QuadQuality before = measure_quads(c.quads, *c.sphere, c.grid.corners);
+  ASSERT_GT(before.inverted_corners, 0) << "the shake should fold quads";
+  QuadSmoothOptions options;
+  options.sweeps = 1;
+  QuadMesh mesh = c.quads;
+  int previous_flipped = before.flipped_quads, previous_inverted = before.inverted_corners;
+  for (int round = 0; round < 10; ++round) {
+    mesh = smooth_quads(mesh, *c.sphere, options).mesh;
+    const QuadQuality q = measure_quads(mesh, *c.sphere, c.grid.corners);
+    EXPECT_LE(q.flipped_quads, previous_flipped) << "round " << round;
+    EXPECT_LE(q.inverted_corners, previous_inverted) << "round " << round;
+    EXPECT_LE(q.max_distance_to_surface, 1e-12);
+    previous_flipped = q.flipped_quads;
+    previous_inverted = q.inverted_corners;
+  }
+  EXPECT_LT(previous_inverted, before.inverted_corners);
+}
+
+TEST(QuadCarry, RemeshPipeline) {
+  const TriMesh& P = eight_polycube().polycube.mesh;
+  const SurfaceProjector surface(P);
+  QuadRemeshOptions options;
+  options.grid.target_quads = 2000;
+  options.smooth.sweeps = 2;
+  const QuadRemeshResult r = remesh_quads(P, [&](const SurfacePoint& p) { return on_mesh(P, p); }, surface, options);
+  EXPECT_EQ(r.mesh.Q, r.grid.mesh.Q);
+  EXPECT_EQ(r.smoothing.sweeps, 2);
+  EXPECT_EQ(r.quality.quads, r.grid.mesh.num_quads());
+  EXPECT_EQ(r.quality.flipped_quads, 0);
+  EXPECT_EQ(r.quality.irregular_vertices, static_cast<int>(r.grid.corners.size()));
+  EXPECT_LE(r.quality.max_distance_to_surface, 1e-12 * r.quality.diagonal);
+  EXPECT_GE(r.seconds_grid, 0);
+  EXPECT_THROW(smooth_quads(r.mesh, surface, QuadSmoothOptions{1, 0.0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace polycube

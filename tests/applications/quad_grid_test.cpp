@@ -1,0 +1,486 @@
+// build_polycube_grid: on synthetic polycubes (voxel unions with uneven spacing, genus 0..2, a
+// saddle where edges of only two directions meet) and on polycubes built from the test meshes,
+// the grid is an all-quad, closed, oriented, connected 2-manifold with P's Euler characteristic;
+// every quad is an axis-aligned rectangle on P; the quads tile P exactly; a vertex has valence 4
+// except at P's cone points, where valence × 90° is P's total angle; the vertices' surface points
+// reproduce their positions; the count follows the target; the result is scale-invariant and the
+// same from a polycube read back from disk.
+#include "applications/quad/carry_grid.h"
+#include "applications/quad/polycube_grid.h"
+#include "applications/quad/quad_quality.h"
+#include "applications/quad/surface_projector.h"
+
+#include "formats/mesh_io.h"
+#include "polycube/errors.h"
+#include "polycube/mesh_topology.h"
+#include "polycube/polycube_build.h"
+#include "polycube/topology.h"
+#include "support/generated_meshes.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+namespace polycube {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The surface of a union of boxes of a rectilinear grid (lines xs, ys, zs), each voxel face on
+// the boundary split into four triangles around its centre (so P's triangulation has vertices
+// that are on no level), outward-oriented.
+TriMesh voxel_polycube(const std::array<std::vector<double>, 3>& lines,
+                       const std::function<bool(int, int, int)>& filled) {
+  const std::array<int, 3> n = {static_cast<int>(lines[0].size()) - 1, static_cast<int>(lines[1].size()) - 1,
+                                static_cast<int>(lines[2].size()) - 1};
+  const auto inside = [&](std::array<int, 3> c) {
+    for (int a = 0; a < 3; ++a)
+      if (c[a] < 0 || c[a] >= n[a]) return false;
+    return filled(c[0], c[1], c[2]);
+  };
+  std::map<std::tuple<int, int, int>, int> corner_id;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3i> faces;
+  const auto corner = [&](std::array<int, 3> c) {
+    const auto key = std::make_tuple(c[0], c[1], c[2]);
+    auto it = corner_id.find(key);
+    if (it != corner_id.end()) return it->second;
+    points.emplace_back(lines[0][c[0]], lines[1][c[1]], lines[2][c[2]]);
+    return corner_id[key] = static_cast<int>(points.size()) - 1;
+  };
+  for (int i = 0; i < n[0]; ++i)
+    for (int j = 0; j < n[1]; ++j)
+      for (int k = 0; k < n[2]; ++k) {
+        if (!filled(i, j, k)) continue;
+        for (int a = 0; a < 3; ++a)
+          for (int s : {-1, 1}) {
+            std::array<int, 3> c = {i, j, k};
+            c[a] += s;
+            if (inside(c)) continue;
+            const int b = (a + 1) % 3, d = (a + 2) % 3;
+            std::array<int, 4> q;
+            const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+            for (int m = 0; m < 4; ++m) {
+              std::array<int, 3> p = {i, j, k};
+              if (s > 0) p[a] += 1;
+              p[b] += du[m];
+              p[d] += dv[m];
+              q[m] = corner(p);
+            }
+            if (s < 0) std::swap(q[1], q[3]);
+            Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+            for (int m = 0; m < 4; ++m) centre += points[q[m]] / 4;
+            points.push_back(centre);
+            const int mid = static_cast<int>(points.size()) - 1;
+            for (int m = 0; m < 4; ++m) faces.emplace_back(q[m], q[(m + 1) % 4], mid);
+          }
+      }
+  TriMesh mesh;
+  mesh.V.resize(points.size(), 3);
+  for (size_t v = 0; v < points.size(); ++v) mesh.V.row(v) = points[v];
+  mesh.F.resize(faces.size(), 3);
+  for (size_t f = 0; f < faces.size(); ++f) mesh.F.row(f) = faces[f];
+  return mesh;
+}
+
+struct Shape {
+  std::string name;
+  TriMesh mesh;
+  int genus;
+};
+
+std::vector<Shape> synthetic_shapes() {
+  std::vector<Shape> shapes;
+  shapes.push_back({"box 1x2x3", voxel_polycube({{{0, 1}, {0, 2}, {0, 3}}}, [](int, int, int) { return true; }), 0});
+  // An L-shaped layer on a single box under one of its arms' junction: the vertex in the middle
+  // is a saddle (6 quads) where edges of only two directions meet.
+  shapes.push_back({"saddle", voxel_polycube({{{0, 1, 2.5}, {0, 0.8, 2}, {0, 1.2, 2}}}, [](int i, int j, int k) {
+                      return k == 1 ? !(i == 1 && j == 0) : (i == 0 && j == 0);
+                    }), 0});
+  shapes.push_back({"stairs", voxel_polycube({{{0, 1, 2, 3}, {0, 1}, {0, 1, 2, 3}}}, [](int i, int, int k) { return k <= i; }), 0});
+  shapes.push_back({"ring", voxel_polycube({{{0, 0.7, 1.0, 2.2}, {0, 1, 1.3, 2}, {0, 0.5}}},
+                                           [](int i, int j, int) { return !(i == 1 && j == 1); }),
+                    1});
+  shapes.push_back({"two holes", voxel_polycube({{{0, 1, 2, 3, 4, 5}, {0, 1, 2, 3}, {0, 0.4, 1}}},
+                                                [](int i, int j, int k) { return !(j == 1 && (i == 1 || i == 3) && k >= 0); }),
+                    2});
+  return shapes;
+}
+
+// Total angle of P at each of its vertices.
+Eigen::VectorXd angle_sums(const TriMesh& mesh) {
+  Eigen::VectorXd angle = Eigen::VectorXd::Zero(mesh.num_vertices());
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d p = mesh.V.row(mesh.F(f, i));
+      const Eigen::Vector3d u = mesh.V.row(mesh.F(f, (i + 1) % 3)).transpose() - p;
+      const Eigen::Vector3d v = mesh.V.row(mesh.F(f, (i + 2) % 3)).transpose() - p;
+      angle[mesh.F(f, i)] += std::acos(std::clamp(u.normalized().dot(v.normalized()), -1.0, 1.0));
+    }
+  return angle;
+}
+
+std::tuple<double, double, double> key_of(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
+// Every property of the grid that holds on any polycube.
+void expect_valid_grid(const TriMesh& P, const PolycubeGrid& grid) {
+  const QuadMesh& quads = grid.mesh;
+  const int nv = quads.num_vertices(), nq = quads.num_quads();
+  ASSERT_GT(nq, 0);
+  ASSERT_EQ(grid.quad_cell.size(), nq);
+  ASSERT_EQ(static_cast<int>(grid.on_polycube.size()), nv);
+  ASSERT_EQ(grid.quad_axis.size(), nq);
+  const double diagonal = bounding_box(P.V).diagonal();
+
+  // Closed, oriented, connected 2-manifold with P's Euler characteristic.
+  const QuadTopology t = quad_topology(quads);
+  EXPECT_EQ(t.boundary_edges, 0) << "T-junctions or holes";
+  EXPECT_EQ(t.nonmanifold_edges, 0);
+  EXPECT_EQ(t.misoriented_edges, 0);
+  EXPECT_EQ(t.nonmanifold_vertices, 0);
+  EXPECT_EQ(t.unreferenced_vertices, 0);
+  EXPECT_EQ(t.components, 1);
+  EXPECT_EQ(t.euler, euler_characteristic(P.F, P.num_vertices()));
+
+  // Every quad an axis-aligned rectangle in its plane, with the outward normal of quad_axis.
+  int not_rectangle = 0, wrong_normal = 0, degenerate = 0;
+  double area = 0;
+  for (int q = 0; q < nq; ++q) {
+    const int axis = std::abs(grid.quad_axis[q]) - 1;
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = quads.V.row(quads.Q(q, k));
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d e = p[(k + 1) % 4] - p[k], f = p[(k + 3) % 4] - p[k];
+      if (e[axis] != 0 || e.dot(f) != 0 || (e.array() != 0).count() != 1) ++not_rectangle;
+      if (e.norm() <= 1e-9 * diagonal) ++degenerate;
+    }
+    const Eigen::Vector3d n = (p[1] - p[0]).cross(p[3] - p[0]);
+    if (n[axis] * grid.quad_axis[q] <= 0) ++wrong_normal;
+    area += n.norm();
+  }
+  EXPECT_EQ(not_rectangle, 0);
+  EXPECT_EQ(wrong_normal, 0);
+  EXPECT_EQ(degenerate, 0);
+  // The quads tile P: same area, and every quad centre on P.
+  EXPECT_NEAR(area, surface_area(P), 1e-9 * surface_area(P));
+  const SurfaceProjector on_p(P);
+  double off = 0;
+  for (int q = 0; q < nq; ++q) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) centre += quads.V.row(quads.Q(q, k)).transpose() / 4;
+    off = std::max(off, on_p.closest(centre).distance);
+  }
+  EXPECT_LE(off, 1e-12 * diagonal);
+
+  // Surface points reproduce the vertices.
+  double error = 0;
+  for (int v = 0; v < nv; ++v) {
+    const SurfacePoint& s = grid.on_polycube[v];
+    ASSERT_TRUE(s.face >= 0 && s.face < P.num_faces());
+    EXPECT_TRUE((s.bary.array() >= 0).all());
+    EXPECT_NEAR(s.bary.sum(), 1, 1e-12);
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) x += s.bary[i] * P.V.row(P.F(s.face, i)).transpose();
+    error = std::max(error, (x - quads.V.row(v).transpose()).norm());
+  }
+  EXPECT_LE(error, 1e-12 * diagonal);
+
+  // Valence 4 except at P's vertices whose total angle is not 2π, where valence × 90° = angle.
+  const Eigen::VectorXd angle = angle_sums(P);
+  std::map<std::tuple<double, double, double>, int> p_vertex;
+  for (int v = 0; v < P.num_vertices(); ++v) p_vertex[key_of(P.V.row(v))] = v;
+  std::set<int> irregular, expected;
+  int wrong_valence = 0;
+  for (int v = 0; v < nv; ++v) {
+    const auto it = p_vertex.find(key_of(quads.V.row(v)));
+    const double total = it == p_vertex.end() ? 2 * kPi : angle[it->second];
+    if (std::abs(total - t.valence[v] * kPi / 2) > 1e-6) ++wrong_valence;
+    if (t.valence[v] != 4) irregular.insert(v);
+    if (std::abs(total - 2 * kPi) > 1e-6) expected.insert(v);
+  }
+  EXPECT_EQ(wrong_valence, 0);
+  EXPECT_EQ(irregular, expected);
+  EXPECT_EQ(irregular, std::set<int>(grid.corners.begin(), grid.corners.end()));
+  EXPECT_EQ(grid.corners.size(), cone_vertices(P).size());
+  ASSERT_EQ(grid.corner_polycube_vertex.size(), grid.corners.size());
+  for (size_t c = 0; c < grid.corners.size(); ++c)
+    EXPECT_EQ(quads.V.row(grid.corners[c]), P.V.row(grid.corner_polycube_vertex[c]));
+
+  // The layout: a closed manifold of rectangles on P's planes; each cell split into
+  // parts x parts equal quads.
+  const QuadTopology lt = quad_topology(grid.layout);
+  EXPECT_TRUE(lt.closed_manifold());
+  EXPECT_EQ(lt.euler, t.euler);
+  ASSERT_EQ(grid.cell_parts.rows(), grid.layout.num_quads());
+  std::vector<int> per_cell(grid.layout.num_quads(), 0);
+  int wrong_size = 0;
+  for (int q = 0; q < nq; ++q) {
+    const int s = grid.quad_cell[q];
+    ASSERT_TRUE(s >= 0 && s < grid.layout.num_quads());
+    ++per_cell[s];
+    for (int k = 0; k < 4; ++k) {
+      const double side = (grid.layout.V.row(grid.layout.Q(s, k % 2 + 1)) - grid.layout.V.row(grid.layout.Q(s, k % 2))).norm();
+      const double edge = (quads.V.row(quads.Q(q, (k + 1) % 4)) - quads.V.row(quads.Q(q, k))).norm();
+      if (std::abs(edge - side / grid.cell_parts(s, k % 2)) > 1e-12 * diagonal) ++wrong_size;
+    }
+  }
+  EXPECT_EQ(wrong_size, 0);
+  for (int s = 0; s < grid.layout.num_quads(); ++s) EXPECT_EQ(per_cell[s], grid.cell_parts(s, 0) * grid.cell_parts(s, 1));
+  for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::is_sorted(grid.levels[a].begin(), grid.levels[a].end()));
+  for (int q = 0; q < nq; ++q) {
+    const int axis = std::abs(grid.quad_axis[q]) - 1;
+    EXPECT_TRUE(std::binary_search(grid.levels[axis].begin(), grid.levels[axis].end(), quads.V(quads.Q(q, 0), axis)));
+  }
+}
+
+TEST(QuadGrid, SyntheticPolycubes) {
+  for (const Shape& shape : synthetic_shapes()) {
+    SCOPED_TRACE(shape.name);
+    ASSERT_EQ(genus(shape.mesh.F, shape.mesh.num_vertices()), shape.genus);
+    for (int target : {1, 300, 3000}) {
+      SCOPED_TRACE("target " + std::to_string(target));
+      PolycubeGridOptions options;
+      options.target_quads = target;
+      const PolycubeGrid grid = build_polycube_grid(shape.mesh, options);
+      expect_valid_grid(shape.mesh, grid);
+      if (target >= 300) {
+        EXPECT_NEAR(grid.mesh.num_quads(), target, 0.1 * target);
+      }
+      if (target == 1) {
+        EXPECT_EQ(grid.mesh.num_quads(), grid.layout.num_quads()) << "one quad per layout cell";
+      }
+    }
+  }
+}
+
+TEST(QuadGrid, SaddleWithTwoEdgeDirectionsIsIrregular) {
+  const Shape shape = synthetic_shapes()[1];
+  const PolycubeGrid grid = build_polycube_grid(shape.mesh, {});
+  const QuadTopology t = quad_topology(grid.mesh);
+  int valence6 = 0;
+  for (int v : grid.corners) valence6 += t.valence[v] == 6;
+  EXPECT_GE(valence6, 1);
+  // A box has exactly its 8 corners, valence 3.
+  const PolycubeGrid box = build_polycube_grid(synthetic_shapes()[0].mesh, {});
+  ASSERT_EQ(box.corners.size(), 8u);
+  const QuadTopology bt = quad_topology(box.mesh);
+  for (int v : box.corners) EXPECT_EQ(bt.valence[v], 3);
+}
+
+TEST(QuadGrid, CellSizeGivesNearSquares) {
+  const Shape shape = synthetic_shapes()[3];
+  for (double h : {0.31, 0.1, 0.037}) {
+    SCOPED_TRACE("h " + std::to_string(h));
+    PolycubeGridOptions options;
+    options.cell_size = h;
+    const PolycubeGrid grid = build_polycube_grid(shape.mesh, options);
+    EXPECT_EQ(grid.cell_size, h);
+    const QuadMesh& layout = grid.layout;
+    for (int q = 0; q < grid.mesh.num_quads(); ++q)
+      for (int k = 0; k < 2; ++k) {
+        const int s = grid.quad_cell[q];
+        const double side = (layout.V.row(layout.Q(s, k + 1)) - layout.V.row(layout.Q(s, k))).norm();
+        if (side < h / 2) {  // narrower than half a quad: one part, as narrow as P makes it
+          EXPECT_EQ(grid.cell_parts(s, k), 1);
+          continue;
+        }
+        const double step = (grid.mesh.V.row(grid.mesh.Q(q, k + 1)) - grid.mesh.V.row(grid.mesh.Q(q, k))).norm();
+        EXPECT_GE(step, h / 2 - 1e-12);
+        EXPECT_LE(step, 1.5 * h + 1e-12);
+      }
+  }
+}
+
+// Two towers of heights 2 and 3 on a common base: the top of the short one is a level whose line
+// around the tall one is needed by nothing, and is removed; without removal it stays.
+TEST(QuadGrid, FreeLoopsAreRemoved) {
+  const TriMesh towers = voxel_polycube({{{0, 1, 2, 3}, {0, 1}, {0, 1, 2, 3}}}, [](int i, int, int k) {
+    return k == 0 || (i == 0 && k == 1) || i == 2;
+  });
+  PolycubeGridOptions options;
+  options.target_quads = 1;
+  const PolycubeGrid merged = build_polycube_grid(towers, options);
+  options.remove_free_loops = false;
+  const PolycubeGrid global = build_polycube_grid(towers, options);
+  expect_valid_grid(towers, merged);
+  expect_valid_grid(towers, global);
+  EXPECT_EQ(merged.free_loops, 1);
+  EXPECT_EQ(global.free_loops, 0);
+  EXPECT_EQ(global.layout.num_quads(), global.level_cells);
+  EXPECT_EQ(merged.layout.num_quads(), global.layout.num_quads() - 4) << "4 cells around the tall tower merge with 4";
+  EXPECT_EQ(merged.corners.size(), global.corners.size());
+  for (const Shape& shape : synthetic_shapes()) {
+    SCOPED_TRACE(shape.name);
+    PolycubeGridOptions plain;
+    plain.remove_free_loops = false;
+    plain.target_quads = 500;
+    expect_valid_grid(shape.mesh, build_polycube_grid(shape.mesh, plain));
+  }
+}
+
+// Sized through a map that stretches x threefold, quads are near-squares on the image (and
+// three times as many columns along x), while sized on P they are 3:1 rectangles there.
+TEST(QuadGrid, SizedThroughAMap) {
+  const TriMesh box = synthetic_shapes()[0].mesh;
+  const SurfaceMap stretch = [&box](const SurfacePoint& p) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) x += p.bary[i] * box.V.row(box.F(p.face, i)).transpose();
+    x.x() *= 3;
+    return x;
+  };
+  TriMesh stretched = box;
+  stretched.V.col(0) *= 3;
+  const SurfaceProjector image(stretched);
+  PolycubeGridOptions options;
+  options.target_quads = 2000;
+  QuadQualityOptions no_sampling;
+  no_sampling.hausdorff = false;
+  const PolycubeGrid on_p = build_polycube_grid(box, options);
+  const PolycubeGrid on_m = build_polycube_grid(box, options, stretch);
+  expect_valid_grid(box, on_m);
+  EXPECT_FALSE(on_p.sized_through_map);
+  EXPECT_TRUE(on_m.sized_through_map);
+  const QuadQuality a = measure_quads(carry_grid(on_p, stretch), image, on_p.corners, no_sampling);
+  const QuadQuality b = measure_quads(carry_grid(on_m, stretch), image, on_m.corners, no_sampling);
+  EXPECT_GT(a.aspect_ratio_max, 2.5);
+  EXPECT_LT(b.aspect_ratio_max, 1.5);
+  EXPECT_LT(b.aspect_ratio_mean, a.aspect_ratio_mean - 0.5);
+  EXPECT_NEAR(b.quads, 2000, 200);
+  EXPECT_EQ(b.flipped_quads, 0);
+}
+
+TEST(QuadGrid, CountGrowsWithTheTarget) {
+  const Shape shape = synthetic_shapes()[4];
+  int previous = 0;
+  for (int target : {10, 100, 400, 1000, 5000, 20000}) {
+    PolycubeGridOptions options;
+    options.target_quads = target;
+    const int count = build_polycube_grid(shape.mesh, options).mesh.num_quads();
+    EXPECT_GE(count, previous);
+    previous = count;
+  }
+  EXPECT_NEAR(previous, 20000, 2000);
+}
+
+TEST(QuadGrid, ScaleAndTranslationInvariant) {
+  const Shape shape = synthetic_shapes()[3];
+  const PolycubeGrid reference = build_polycube_grid(shape.mesh, {});
+  for (double scale : {1e-8, 1e8}) {
+    TriMesh moved = shape.mesh;
+    moved.V = (moved.V * scale).rowwise() + Eigen::RowVector3d(3 * scale, -5 * scale, 7 * scale);
+    const PolycubeGrid grid = build_polycube_grid(moved, {});
+    EXPECT_EQ(grid.mesh.Q, reference.mesh.Q);
+    EXPECT_EQ(grid.cell_parts, reference.cell_parts);
+    const Eigen::MatrixX3d expected = (reference.mesh.V * scale).rowwise() + Eigen::RowVector3d(3 * scale, -5 * scale, 7 * scale);
+    EXPECT_LE((grid.mesh.V - expected).cwiseAbs().maxCoeff(), 1e-12 * scale);
+    EXPECT_EQ(grid.corners, reference.corners);
+  }
+}
+
+// A polycube written turned (as `polycube map` writes P back in the input's frame): gridded in
+// its own axes, the same grid turned.
+TEST(QuadGrid, TurnedPolycube) {
+  const Shape shape = synthetic_shapes()[4];
+  const Eigen::Matrix3d turn =
+      (Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()) * Eigen::AngleAxisd(-1.9, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  TriMesh turned = shape.mesh;
+  turned.V = shape.mesh.V * turn.transpose();
+  PolycubeGridOptions options;
+  options.cell_size = 0.0937;  // no width is near a half-integer multiple: the same parts either way
+  const PolycubeGrid reference = build_polycube_grid(shape.mesh, options);
+  const PolycubeGrid grid = build_polycube_grid(turned, options);
+  EXPECT_TRUE(reference.frame.isIdentity(0));
+  EXPECT_LE((grid.frame.transpose() * grid.frame - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 1e-12);
+  // The same vertices (in another order: P's axes may come out permuted).
+  ASSERT_EQ(grid.mesh.num_quads(), reference.mesh.num_quads());
+  ASSERT_EQ(grid.mesh.num_vertices(), reference.mesh.num_vertices());
+  EXPECT_EQ(grid.corners.size(), reference.corners.size());
+  const Eigen::MatrixX3d back = grid.mesh.V * turn;  // into the unturned frame
+  const auto rounded = [](const Eigen::MatrixX3d& V) {
+    std::vector<std::tuple<long long, long long, long long>> points;
+    for (int v = 0; v < V.rows(); ++v)
+      points.emplace_back(std::llround(V(v, 0) * 1e9), std::llround(V(v, 1) * 1e9), std::llround(V(v, 2) * 1e9));
+    std::sort(points.begin(), points.end());
+    return points;
+  };
+  EXPECT_EQ(rounded(back), rounded(reference.mesh.V));
+  const QuadTopology t = quad_topology(grid.mesh);
+  EXPECT_TRUE(t.closed_manifold());
+  // Each quad a rectangle on the turned P, its normal along one of P's axes.
+  const SurfaceProjector on_p(turned);
+  double worst_angle = 0, off = 0;
+  for (int q = 0; q < grid.mesh.num_quads(); ++q) {
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = grid.mesh.V.row(grid.mesh.Q(q, k));
+    for (int k = 0; k < 4; ++k)
+      worst_angle = std::max(worst_angle, std::abs((p[(k + 1) % 4] - p[k]).normalized().dot((p[(k + 3) % 4] - p[k]).normalized())));
+    off = std::max(off, on_p.closest((p[0] + p[1] + p[2] + p[3]) / 4).distance);
+  }
+  EXPECT_LE(worst_angle, 1e-12);
+  EXPECT_LE(off, 1e-12);
+}
+
+TEST(QuadGrid, RejectsNonPolycubesAndBadOptions) {
+  EXPECT_THROW(build_polycube_grid(test::make_sphere(1), {}), MeshError);
+  PolycubeGridOptions options;
+  options.cell_size = -1;
+  EXPECT_THROW(build_polycube_grid(synthetic_shapes()[0].mesh, options), std::invalid_argument);
+  options.cell_size = 1e-5;  // 2 · (1·2 + 2·3 + 1·3) · 1e10 quads
+  EXPECT_THROW(build_polycube_grid(synthetic_shapes()[0].mesh, options), AlgorithmError);
+}
+
+// P built by the engine from real meshes; P.corners (edges of three directions) are among the
+// irregular vertices, and every irregular vertex is a polycube vertex.
+TEST(QuadGrid, PolycubesOfTestMeshes) {
+  for (const std::string name : {"sphere.off", "eight.off", "torus_quad.off", "anchor.off", "double-torus-example.off"}) {
+    SCOPED_TRACE(name);
+    const TriMesh model = test::load_test_mesh(name);
+    const PolycubeResult built = build_polycube(model, analyse_topology(model));
+    const Polycube& P = built.polycube;
+    PolycubeGridOptions options;
+    options.target_quads = 4000;
+    const PolycubeGrid grid = build_polycube_grid(P.mesh, options);
+    expect_valid_grid(P.mesh, grid);
+    EXPECT_EQ(quad_topology(grid.mesh).genus(), built.genus);
+    if (static_cast<long long>(options.target_quads) > 2 * grid.layout.num_quads()) {
+      EXPECT_NEAR(grid.mesh.num_quads(), options.target_quads, 0.15 * options.target_quads);
+    }
+
+    const std::set<int> at(grid.corner_polycube_vertex.begin(), grid.corner_polycube_vertex.end());
+    for (int c : P.corners) EXPECT_TRUE(at.count(c)) << "polycube corner " << c << " regular";
+    for (int c : at) EXPECT_TRUE(std::binary_search(P.vertices.begin(), P.vertices.end(), c)) << "vertex " << c;
+  }
+}
+
+// From P written as OBJ and read back (as `quad --map DIR` does), the same grid.
+TEST(QuadGrid, SameFromPolycubeReadBackFromDisk) {
+  const TriMesh model = test::load_test_mesh("eight.off");
+  const PolycubeResult built = build_polycube(model, analyse_topology(model));
+  const std::string path = test::temp_dir("quad-grid") + "/polycube.obj";
+  write_mesh(path, built.polycube.mesh);
+  const PolygonSoup soup = read_polygon_soup(path);
+  TriMesh back;
+  back.V.resize(soup.points.size(), 3);
+  for (size_t v = 0; v < soup.points.size(); ++v) back.V.row(v) = soup.points[v];
+  back.F.resize(soup.polygons.size(), 3);
+  for (size_t f = 0; f < soup.polygons.size(); ++f) back.F.row(f) << soup.polygons[f][0], soup.polygons[f][1], soup.polygons[f][2];
+  const PolycubeGrid a = build_polycube_grid(built.polycube.mesh, {}), b = build_polycube_grid(back, {});
+  EXPECT_EQ(a.mesh.V, b.mesh.V);
+  EXPECT_EQ(a.mesh.Q, b.mesh.Q);
+  EXPECT_EQ(a.corners, b.corners);
+}
+
+}  // namespace
+}  // namespace polycube
