@@ -54,6 +54,24 @@ EdgeMap build_edge_map(const Eigen::MatrixX3i& F) {
   return map;
 }
 
+EdgeDefects edge_defects(const Eigen::MatrixX3i& F, const EdgeMap& edges) {
+  EdgeDefects defects;
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    if (edges.face_count[e] == 1) ++defects.boundary;
+    if (edges.face_count[e] > 2) ++defects.nonmanifold;
+    if (edges.face_count[e] != 2) continue;
+    // The two faces must run through the edge in opposite directions.
+    int forward = 0;
+    for (int k = 0; k < 2; ++k) {
+      const int f = edges.EF(e, k);
+      for (int i = 0; i < 3; ++i)
+        if (edges.FE(f, i) == e) forward += F(f, i) == edges.E(e, 0);
+    }
+    if (forward != 1) ++defects.misoriented;
+  }
+  return defects;
+}
+
 std::vector<std::vector<int>> boundary_loops(const Eigen::MatrixX3i& F) {
   const EdgeMap map = build_edge_map(F);
   // Directed boundary half-edges u -> v, keyed by their start vertex.

@@ -27,6 +27,18 @@ struct EdgeMap {
 
 EdgeMap build_edge_map(const Eigen::MatrixX3i& F);
 
+// How the faces meet along the edges: edges with one face (boundary), with more than two
+// (non-manifold), and with two faces running through them in the same direction (inconsistently
+// oriented). All zero for a closed, edge-manifold, consistently oriented mesh.
+struct EdgeDefects {
+  int boundary = 0;
+  int nonmanifold = 0;
+  int misoriented = 0;
+};
+
+// edges = build_edge_map(F).
+EdgeDefects edge_defects(const Eigen::MatrixX3i& F, const EdgeMap& edges);
+
 // Boundary loops of an edge-manifold mesh as ordered vertex cycles, each following the
 // orientation of its faces. Edges used by one face only are boundary edges. Where boundary
 // vertices are not manifold, loops are still closed but their split at such vertices is arbitrary.

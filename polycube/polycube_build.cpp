@@ -7,6 +7,7 @@
 #include "polycube/polycube_verify.h"
 #include "polycube/quadtree_sampled.h"
 #include "polycube/quadtree_section.h"
+#include "polycube/quadtree_simplify.h"
 #include "polycube/quadtree_topology.h"
 
 #include <Eigen/Geometry>
@@ -67,17 +68,11 @@ TriMesh sliced_surface(const SlicedMesh& sliced) {
     surface.F.row(o) << k[0], k[1], k[2];
   }
   // Must be consistently oriented.
-  const EdgeMap edges = build_edge_map(surface.F);
-  for (int e = 0; e < edges.num_edges(); ++e) {
-    if (edges.face_count[e] != 2) throw AlgorithmError("build_polycube: the recovered sliced surface is not closed");
-    int forward = 0;
-    for (int k = 0; k < 2; ++k) {
-      const int f = edges.EF(e, k);
-      for (int i = 0; i < 3; ++i)
-        if (edges.FE(f, i) == e) forward += surface.F(f, i) == edges.E(e, 0);
-    }
-    if (forward != 1) throw AlgorithmError("build_polycube: the recovered sliced surface is not consistently oriented");
-  }
+  const EdgeDefects defects = edge_defects(surface.F, build_edge_map(surface.F));
+  if (defects.boundary || defects.nonmanifold)
+    throw AlgorithmError("build_polycube: the recovered sliced surface is not closed");
+  if (defects.misoriented)
+    throw AlgorithmError("build_polycube: the recovered sliced surface is not consistently oriented");
   return surface;
 }
 
@@ -391,24 +386,100 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
     result.accuracy_splits += state.quadtree.accuracy_splits;
     result.section_splits += state.quadtree.topology_splits;
     result.section_relabels += state.quadtree.topology_relabels;
-    result.deepest_level = std::max(result.deepest_level, state.quadtree.deepest_level);
-    for (double e : state.quadtree.region_error) result.max_region_error = std::max(result.max_region_error, e);
   }
 
-  // The surface and its triangulation.
+  // Simplification: merge sibling leaves back where the repairs made finer cells than d_a, the
+  // sections' topology and both slabs need, then let each Q_i follow its neighbours where that
+  // removes corners — every change checked like the repairs' (fewer corners, same guarantee).
   auto t = Clock::now();
+  const int n = static_cast<int>(sliced.planes.size());
   std::vector<std::vector<QuadLeaf>> final_leaves;
   for (const auto* l : leaves) final_leaves.push_back(*l);
+  const std::vector<std::vector<QuadLeaf>> refined_leaves =
+      options.simplify ? final_leaves : std::vector<std::vector<QuadLeaf>>{};
+  if (options.simplify) {
+    // No merged cell wider than the widest gap between planes: Q's boundary moves horizontally
+    // by about as much as the extrusions already stand off vertically.
+    double widest_gap = z_max - z_min;
+    if (n > 1) {
+      widest_gap = 0;
+      for (int i = 0; i + 1 < n; ++i) widest_gap = std::max(widest_gap, sliced.planes[i + 1] - sliced.planes[i]);
+    }
+    const int coarsest_level =
+        std::clamp(static_cast<int>(std::ceil(std::log2(frame.scale / widest_gap) - 1e-9)), 0, kQuadGridBits);
+    std::vector<std::vector<std::vector<int>>> model_pieces(n + 1);
+    for (size_t p = 0; p < sliced.pieces.size(); ++p)
+      model_pieces[sliced.pieces[p].plane_below + 1].push_back(sections.piece_contours[p]);
+    // Plane i's two slabs with `trial` as Q_i.
+    auto slabs_pass = [&](int i) {
+      return [&, i](const std::vector<QuadLeaf>& trial, std::vector<char>& implicated) {
+        const SlabCheck below = check_slab(sections, i > 0 ? SlabSide{i - 1, &final_leaves[i - 1]} : SlabSide{},
+                                           SlabSide{i, &trial}, model_pieces[i]);
+        const SlabCheck above = check_slab(sections, SlabSide{i, &trial},
+                                           i + 1 < n ? SlabSide{i + 1, &final_leaves[i + 1]} : SlabSide{},
+                                           model_pieces[i + 1]);
+        for (int l : below.hi_refine) implicated[l] = 1;
+        for (int l : above.lo_refine) implicated[l] = 1;
+        return below.ok() && above.ok();
+      };
+    };
+    auto neighbour = [&](int j) {
+      return j >= 0 && j < n ? SnapNeighbour{&sections.planes[j], &final_leaves[j]} : SnapNeighbour{};
+    };
+    for (int i = 0; i < n; ++i) {
+      CoarsenedSection coarsened =
+          coarsen_section(sections.planes[i], final_leaves[i], options.da, coarsest_level, slabs_pass(i));
+      result.coarsening_merges += coarsened.merges;
+      final_leaves[i] = std::move(coarsened.leaves);
+    }
+    // Upwards, each plane following the one below; then downwards, following the one above.
+    for (int pass = 0; pass < 2; ++pass)
+      for (int k = 1; k < n; ++k) {
+        const int i = pass == 0 ? k : n - 1 - k;
+        CoarsenedSection snapped = snap_section(sections.planes[i], final_leaves[i], options.da, coarsest_level,
+                                                neighbour(i - 1), neighbour(i + 1), pass == 0, slabs_pass(i));
+        result.snapped_cells += snapped.merges;
+        final_leaves[i] = std::move(snapped.leaves);
+      }
+  }
+  result.seconds_simplify = seconds_since(t);
+
+  // The surface and its triangulation, and the guarantee, on the mesh. Should the simplified
+  // quadtrees fail the final check (the slab checks are combinatorial, the final one is not),
+  // P is built again from the quadtrees as the repairs left them.
   PolycubeSurfaceOptions surface_options;
   surface_options.target_vertices = options.target_vertices > 0 ? options.target_vertices : model.num_vertices();
   surface_options.avoid_z = sliced.planes;
-  result.polycube = build_polycube_surface(sections, final_leaves, z_min, z_max, surface_options);
-  result.seconds_surface = seconds_since(t);
-
-  // The guarantee, on the mesh.
-  t = Clock::now();
-  PolycubeVerification verification = verify_polycube(result.polycube, sections, sliced, topology.genus);
-  result.seconds_verify = seconds_since(t);
+  PolycubeVerification verification;
+  const std::vector<std::vector<QuadLeaf>>* attempts[2] = {&final_leaves, &refined_leaves};
+  const std::vector<std::vector<QuadLeaf>>* used = nullptr;
+  for (const auto* attempt : attempts) {
+    if (attempt->empty()) continue;
+    used = attempt;
+    const bool simplified = options.simplify && attempt == &final_leaves;
+    std::string problem;
+    try {
+      t = Clock::now();
+      result.polycube = build_polycube_surface(sections, *attempt, z_min, z_max, surface_options);
+      result.seconds_surface += seconds_since(t);
+      t = Clock::now();
+      verification = verify_polycube(result.polycube, sections, sliced, topology.genus);
+      result.seconds_verify += seconds_since(t);
+      if (verification.ok() || !simplified) break;
+      problem = verification.problems.front();
+    } catch (const AlgorithmError& e) {
+      if (!simplified) throw;
+      problem = e.what();
+    }
+    result.repairs.push_back("simplified quadtrees fail the final check (" + problem +
+                             "): rebuilt without simplification");
+    result.coarsening_merges = result.snapped_cells = 0;
+  }
+  for (int i = 0; i < n; ++i) {
+    for (const QuadLeaf& leaf : (*used)[i]) result.deepest_level = std::max(result.deepest_level, leaf.cell.level);
+    for (double e : region_errors(sections.planes[i], (*used)[i]))
+      result.max_region_error = std::max(result.max_region_error, e);
+  }
   if (!verification.ok()) {
     std::string text;
     for (const std::string& p : verification.problems) text += (text.empty() ? "" : "; ") + p;

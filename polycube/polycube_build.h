@@ -40,6 +40,12 @@ struct PolycubeOptions {
   int max_rounds = 80;
   // Thinnest slab, as a fraction of the model's height, that may still get a plane inserted.
   double min_slab = 1e-5;
+  // Once every slab passes, simplify the quadtrees wherever d_a, the sections' topology and both
+  // slabs' checks allow: merge sibling leaves the repairs split (coarsen_section), then relabel
+  // leaves so that each Q_i follows its neighbours where that removes corners (snap_section).
+  // No cell is merged into one wider than the widest gap between planes, none relabelled wider
+  // than half of it. Fewer, larger steps: fewer corners.
+  bool simplify = true;
 };
 
 // Everything the stage did.
@@ -63,7 +69,10 @@ struct PolycubeOptions {
 //   relabelled_cells  cells grown into or shrunk out of a Q_i to remove non-manifold touches
 //   rounds            check-and-repair rounds (1 when nothing needed repair)
 //   deepest_level     of any quadtree leaf
-//   max_region_error  largest area(Q_r Δ R_r) / area(R_r) over all regions of all planes
+//   max_region_error  largest area(Q_r Δ R_r) / area(R_r) over all regions of all planes (the
+//                     simplification keeps every region within max(d_a, what the repairs left))
+//   coarsening_merges  sibling leaf groups merged into their parent by the simplification
+//   snapped_cells     leaves the simplification relabelled to follow a neighbouring plane
 //   repairs           one line per repair made
 struct PolycubeResult {
   Polycube polycube;
@@ -83,9 +92,12 @@ struct PolycubeResult {
   int rounds = 0;
   int deepest_level = 0;
   double max_region_error = 0;
+  int coarsening_merges = 0;
+  int snapped_cells = 0;
   std::vector<std::string> repairs;
   double seconds_quadtrees = 0;  // building and repairing the quadtrees
   double seconds_checks = 0;     // slab checks and re-slicing
+  double seconds_simplify = 0;   // coarsening and snapping after the checks pass
   double seconds_surface = 0;    // faces, edges and triangulation of P
   double seconds_verify = 0;     // final check of P
   double seconds_total = 0;
@@ -103,8 +115,11 @@ struct PolycubeResult {
 //      the cells where the slab's regions meet; otherwise by inserting a plane in the middle of
 //      the slab and re-slicing the model. Inserted planes whose cross-section cannot be
 //      approximated (a neck finer than the deepest cells) are moved within their slab;
-//   4. the surface, its faces, edges and corners, triangulated (build_polycube_surface);
-//   5. the guarantee checked on the triangle mesh (verify_polycube).
+//   4. simplification (PolycubeOptions::simplify): leaves merged back and relabelled to follow
+//      the neighbouring planes where d_a, the sections' topology and both slabs' checks allow;
+//   5. the surface, its faces, edges and corners, triangulated (build_polycube_surface);
+//   6. the guarantee checked on the triangle mesh (verify_polycube); should the simplified
+//      quadtrees fail it, P is built again from the unsimplified ones and checked again.
 //   model     the closed mesh the topology stage ran on (input frame)
 //   topology  analyse_topology(model, ...)
 // Throws AlgorithmError when the repairs exceed their limits or P fails its final check — an

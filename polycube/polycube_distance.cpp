@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <tuple>
 #include <stdexcept>
 #include <vector>
 
@@ -59,19 +58,31 @@ std::vector<Point> samples_of(const TriMesh& mesh, int count, unsigned seed) {
   return samples;
 }
 
-// Largest and mean distance from the samples of `from` to the surface of `to`.
-std::pair<double, double> one_sided(const TriMesh& from, const TriMesh& to, const HausdorffOptions& options) {
+// Largest and mean distance from the samples of `from` to the surface of `to`, and the sample
+// farthest away.
+struct OneSided {
+  double largest = 0;
+  double mean = 0;
+  Eigen::Vector3d farthest = Eigen::Vector3d::Zero();
+};
+
+OneSided one_sided(const TriMesh& from, const TriMesh& to, const HausdorffOptions& options) {
   const std::vector<Triangle> triangles = triangles_of(to);
   Tree tree(triangles.begin(), triangles.end());
   tree.accelerate_distance_queries();
-  double largest = 0, sum = 0;
+  OneSided result;
+  double sum = 0;
   const std::vector<Point> samples = samples_of(from, options.samples, options.seed);
   for (const Point& p : samples) {
     const double d = std::sqrt(tree.squared_distance(p));
-    largest = std::max(largest, d);
+    if (d > result.largest) {
+      result.largest = d;
+      result.farthest = {p.x(), p.y(), p.z()};
+    }
     sum += d;
   }
-  return {largest, samples.empty() ? 0.0 : sum / samples.size()};
+  result.mean = samples.empty() ? 0.0 : sum / samples.size();
+  return result;
 }
 
 }  // namespace
@@ -79,8 +90,13 @@ std::pair<double, double> one_sided(const TriMesh& from, const TriMesh& to, cons
 HausdorffDistance hausdorff_distance(const TriMesh& a, const TriMesh& b, const HausdorffOptions& options) {
   if (a.num_faces() == 0 || b.num_faces() == 0) throw std::invalid_argument("hausdorff_distance: empty mesh");
   HausdorffDistance result;
-  std::tie(result.a_to_b, result.mean_a_to_b) = one_sided(a, b, options);
-  std::tie(result.b_to_a, result.mean_b_to_a) = one_sided(b, a, options);
+  const OneSided ab = one_sided(a, b, options), ba = one_sided(b, a, options);
+  result.a_to_b = ab.largest;
+  result.mean_a_to_b = ab.mean;
+  result.a_farthest = ab.farthest;
+  result.b_to_a = ba.largest;
+  result.mean_b_to_a = ba.mean;
+  result.b_farthest = ba.farthest;
   result.hausdorff = std::max(result.a_to_b, result.b_to_a);
   return result;
 }

@@ -4,6 +4,8 @@
 
 #include "polycube/mesh.h"
 
+#include <Eigen/Core>
+
 namespace polycube {
 
 struct HausdorffOptions {
@@ -17,12 +19,15 @@ struct HausdorffOptions {
 //   a_to_b  largest distance from a sample of a to the surface of b (and b_to_a the other way)
 //   hausdorff  max(a_to_b, b_to_a)
 //   mean_a_to_b, mean_b_to_a  mean sample distances
+//   a_farthest, b_farthest  the sample of a farthest from b (at a_to_b), and of b from a
 struct HausdorffDistance {
   double a_to_b = 0;
   double b_to_a = 0;
   double hausdorff = 0;
   double mean_a_to_b = 0;
   double mean_b_to_a = 0;
+  Eigen::Vector3d a_farthest = Eigen::Vector3d::Zero();
+  Eigen::Vector3d b_farthest = Eigen::Vector3d::Zero();
 };
 
 // Samples each surface and measures the exact distance of every sample to the other surface

@@ -1,26 +1,16 @@
 #include "polycube/polycube_slab_check.h"
 
+#include "polycube/disjoint_sets.h"
 #include "polycube/quadtree_raster.h"
 
 #include <algorithm>
 #include <array>
 #include <map>
-#include <numeric>
 #include <sstream>
 
 namespace polycube {
 
 namespace {
-
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
-};
 
 // The link of a vertex of a union of octants is the octahedron's faces (octants) marked inside;
 // the surface there is the cone over the boundary of that set, a disk iff the boundary is one
@@ -97,11 +87,16 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
   }
   const QuadRaster raster = rasterize({side_leaves[0], side_leaves[1]});
   const int nx = raster.nx(), ny = raster.ny();
-  auto face = [&](int s, int cx, int cy) {
-    const int l = raster.leaf_at(s, cx, cy);
-    return l < 0 ? 0 : (*side_leaves[s])[l].face;
-  };
-  auto solid = [&](int s, int cx, int cy) { return side_section[s]->face_solid[face(s, cx, cy)] != 0; };
+  const size_t row = static_cast<size_t>(nx) + 2;
+  std::vector<int> faces[2];
+  std::vector<char> solids[2];
+  for (int s = 0; s < 2; ++s) {
+    faces[s] = padded_faces(raster, s, *side_leaves[s]);
+    solids[s].resize(faces[s].size());
+    for (size_t k = 0; k < faces[s].size(); ++k) solids[s][k] = side_section[s]->face_solid[faces[s][k]];
+  }
+  auto face = [&](int s, int cx, int cy) { return faces[s][(cy + 1) * row + cx + 1]; };
+  auto solid = [&](int s, int cx, int cy) { return solids[s][(cy + 1) * row + cx + 1] != 0; };
   std::vector<char> refine[2];
   refine[0].assign(side_leaves[0]->size(), 0);
   refine[1].assign(side_leaves[1]->size(), 0);

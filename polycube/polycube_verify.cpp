@@ -65,23 +65,11 @@ PolycubeVerification verify_polycube(const Polycube& polycube, const CrossSectio
   if (tilted) problem(std::to_string(tilted) + " triangles whose normal is not exactly their face's axis direction");
 
   // Closed, oriented, manifold, connected, of the model's genus, enclosing positive volume.
-  const EdgeMap edges = build_edge_map(mesh.F);
-  int open = 0, nonmanifold = 0, misoriented = 0;
-  for (int e = 0; e < edges.num_edges(); ++e) {
-    if (edges.face_count[e] < 2) ++open;
-    if (edges.face_count[e] > 2) ++nonmanifold;
-    if (edges.face_count[e] != 2) continue;
-    int forward = 0;
-    for (int k = 0; k < 2; ++k) {
-      const int f = edges.EF(e, k);
-      for (int i = 0; i < 3; ++i)
-        if (edges.FE(f, i) == e) forward += mesh.F(f, i) == edges.E(e, 0);
-    }
-    if (forward != 1) ++misoriented;
-  }
-  if (open) problem(std::to_string(open) + " boundary edges");
-  if (nonmanifold) problem(std::to_string(nonmanifold) + " edges with more than two triangles");
-  if (misoriented) problem(std::to_string(misoriented) + " edges whose triangles disagree in orientation");
+  const EdgeDefects defects = edge_defects(mesh.F, build_edge_map(mesh.F));
+  if (defects.boundary) problem(std::to_string(defects.boundary) + " boundary edges");
+  if (defects.nonmanifold) problem(std::to_string(defects.nonmanifold) + " edges with more than two triangles");
+  if (defects.misoriented)
+    problem(std::to_string(defects.misoriented) + " edges whose triangles disagree in orientation");
   if (!result.problems.empty()) return result;
   const int bad_vertices = count_nonmanifold_vertices(mesh.F, nv);
   if (bad_vertices) problem(std::to_string(bad_vertices) + " non-manifold vertices");

@@ -42,4 +42,15 @@ QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections) 
   return raster;
 }
 
+std::vector<int> padded_faces(const QuadRaster& raster, int s, const std::vector<QuadLeaf>& leaves) {
+  const int nx = raster.nx(), ny = raster.ny(), row = nx + 2;
+  std::vector<int> faces(static_cast<size_t>(row) * (ny + 2), 0);
+  for (int cy = 0; cy < ny; ++cy) {
+    const int* leaf = raster.leaf[s].data() + static_cast<size_t>(cy) * nx;
+    int* face = faces.data() + static_cast<size_t>(cy + 1) * row + 1;
+    for (int cx = 0; cx < nx; ++cx) face[cx] = leaf[cx] < 0 ? 0 : leaves[leaf[cx]].face;
+  }
+  return faces;
+}
+
 }  // namespace polycube

@@ -28,4 +28,9 @@ struct QuadRaster {
 // Rasterizes the leaf sets (each covering the unit square) on their common grid.
 QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections);
 
+// The faces of section s's leaves (its leaf list) on the raster's cells with the padding ring:
+// element (cy + 1) * (nx + 2) + cx + 1 for cell (cx, cy), face 0 (outside) in the padding. For
+// checks that look up neighbouring cells many times.
+std::vector<int> padded_faces(const QuadRaster& raster, int s, const std::vector<QuadLeaf>& leaves);
+
 }  // namespace polycube

@@ -27,6 +27,7 @@ struct Node {
   int first_child = -1;  // children at first_child .. first_child + 3
   bool imposed = false;  // its face comes from a label edit
   int base_face = 0;     // face just inside the deepest contour around the whole cell
+  int accuracy_level = 0;  // level of the d_a refinement's leaf containing it
   std::vector<Clip> clips;
   int face = 0;
   std::vector<std::pair<int, double>> face_areas;
@@ -101,9 +102,11 @@ class Builder {
     nodes_[n].clips.shrink_to_fit();
     nodes_[n].face_areas.clear();
     nodes_[n].first_child = first;
+    const int accuracy_level = refining_accuracy_ ? parent_cell.level + 1 : nodes_[n].accuracy_level;
     for (int q = 0; q < 4; ++q) {
       Node child;
       child.cell = {parent_cell.level + 1, 2 * parent_cell.ix + (q & 1), 2 * parent_cell.iy + (q >> 1)};
+      child.accuracy_level = accuracy_level;
       nodes_.push_back(std::move(child));
       classify(first + q, clips, base);
     }
@@ -131,6 +134,8 @@ class Builder {
   }
   const Node& node(int n) const { return nodes_[n]; }
   int deepest() const { return deepest_; }
+  // Splits from now on are not for d_a: their leaves keep the level of the leaf they refine.
+  void accuracy_done() { refining_accuracy_ = false; }
 
   // Subdivides the leaves containing `cell` down to below its level.
   int split_down_to(const QuadCell& cell) {
@@ -231,6 +236,7 @@ class Builder {
   std::map<QuadCell, int> labels_;
   std::vector<Node> nodes_;
   int deepest_ = 0;
+  bool refining_accuracy_ = true;
 };
 
 QuadLeaf leaf_of(const Node& node) {
@@ -239,6 +245,7 @@ QuadLeaf leaf_of(const Node& node) {
   leaf.face = node.face;
   leaf.mixed = !node.clips.empty();
   if (leaf.mixed) leaf.face_areas = node.face_areas;
+  leaf.accuracy_level = node.accuracy_level;
   return leaf;
 }
 
@@ -302,6 +309,7 @@ QuadtreeSection approximate_section(const CrossSections& sections, int plane, co
     result.accuracy_splits += static_cast<int>(to_split.size());
   }
 
+  builder.accuracy_done();
   for (const QuadCell& cell : edits.splits)
     if (cell.level < max_repair_level) result.forced_splits += builder.split_down_to(cell);
 

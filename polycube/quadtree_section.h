@@ -39,11 +39,14 @@ struct QuadCell {
 //               face covering most of its area; Q_i is the union of cells with a solid face
 //   mixed       contours cross the cell
 //   face_areas  for mixed cells: (face, area in normalised units) of every face present
+//   accuracy_level  level of the leaf of the d_a refinement that contains the cell: deeper leaves
+//               come from the topology and stacking repairs
 struct QuadLeaf {
   QuadCell cell;
   int face = 0;
   bool mixed = false;
   std::vector<std::pair<int, double>> face_areas;
+  int accuracy_level = 0;
 
   double area_of(int f) const {
     for (const auto& [g, a] : face_areas)

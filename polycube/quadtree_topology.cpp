@@ -1,24 +1,31 @@
 #include "polycube/quadtree_topology.h"
 
+#include "polycube/disjoint_sets.h"
 #include "polycube/quadtree_raster.h"
 
 #include <cmath>
 #include <map>
-#include <numeric>
 
 namespace polycube {
 
 namespace {
 
-struct DisjointSets {
-  std::vector<int> parent;
-  explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) { parent[find(a)] = find(b); }
-};
+// The 4-connected components of equal face among the raster's cells (cell (cx, cy) is element
+// cy * nx + cx); the outside face's cells on the border of the unit square join element nx * ny,
+// which stands for the padding ring.
+template <typename Label>
+DisjointSets face_components(int nx, int ny, const Label& label) {
+  const int border = nx * ny;
+  DisjointSets sets(nx * ny + 1);
+  for (int cy = 0; cy < ny; ++cy)
+    for (int cx = 0; cx < nx; ++cx) {
+      const int f = label(cx, cy), id = cy * nx + cx;
+      if (cx + 1 < nx && label(cx + 1, cy) == f) sets.unite(id, id + 1);
+      if (cy + 1 < ny && label(cx, cy + 1) == f) sets.unite(id, id + nx);
+      if (f == 0 && (cx == 0 || cy == 0 || cx == nx - 1 || cy == ny - 1)) sets.unite(id, border);
+    }
+  return sets;
+}
 
 }  // namespace
 
@@ -31,10 +38,9 @@ std::string check_section_topology(const PlaneSection& section, const std::vecto
   auto note = [&](const std::string& text) {
     if (problem.empty()) problem = text;
   };
-  auto label = [&](int cx, int cy) {
-    const int l = raster.leaf_at(0, cx, cy);
-    return l < 0 ? 0 : leaves[l].face;
-  };
+  const size_t row = static_cast<size_t>(nx) + 2;
+  const std::vector<int> faces = padded_faces(raster, 0, leaves);
+  auto label = [&](int cx, int cy) { return faces[(cy + 1) * row + cx + 1]; };
   auto mark_cell = [&](int cx, int cy) {
     const int l = raster.leaf_at(0, cx, cy);
     if (l >= 0) mark[l] = 1;
@@ -42,14 +48,7 @@ std::string check_section_topology(const PlaneSection& section, const std::vecto
 
   // Components of every face (4-connected; the outside joins the padding ring).
   const int border = nx * ny;
-  DisjointSets sets(nx * ny + 1);
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx) {
-      const int f = label(cx, cy), id = cy * nx + cx;
-      if (cx + 1 < nx && label(cx + 1, cy) == f) sets.unite(id, id + 1);
-      if (cy + 1 < ny && label(cx, cy + 1) == f) sets.unite(id, id + nx);
-      if (f == 0 && (cx == 0 || cy == 0 || cx == nx - 1 || cy == ny - 1)) sets.unite(id, border);
-    }
+  DisjointSets sets = face_components(nx, ny, label);
   std::vector<int> root(nf, -1);
   std::vector<char> split_face(nf, 0);
   root[0] = sets.find(border);
@@ -105,10 +104,9 @@ std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& s
   const QuadRaster raster = rasterize({&leaves});
   const int nx = raster.nx(), ny = raster.ny();
   auto leaf_at = [&](int cx, int cy) { return raster.leaf_at(0, cx, cy); };
-  auto label = [&](int cx, int cy) {
-    const int l = leaf_at(cx, cy);
-    return l < 0 ? 0 : leaves[l].face;
-  };
+  const size_t row = static_cast<size_t>(nx) + 2;
+  const std::vector<int> faces = padded_faces(raster, 0, leaves);
+  auto label = [&](int cx, int cy) { return faces[(cy + 1) * row + cx + 1]; };
   // Fraction of a cell's leaf covered by face f in truth.
   auto fraction = [&](int l, int f) {
     if (l < 0) return f == 0 ? 1.0 : 0.0;
@@ -165,20 +163,13 @@ std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& s
   if (relabel.empty()) {
     // Stray components: all but the largest component of each face take their neighbours' face.
     const int border = nx * ny;
-    DisjointSets sets(nx * ny + 1);
-    for (int cy = 0; cy < ny; ++cy)
-      for (int cx = 0; cx < nx; ++cx) {
-        const int f = label(cx, cy), id = cy * nx + cx;
-        if (cx + 1 < nx && label(cx + 1, cy) == f) sets.unite(id, id + 1);
-        if (cy + 1 < ny && label(cx, cy + 1) == f) sets.unite(id, id + nx);
-        if (f == 0 && (cx == 0 || cy == 0 || cx == nx - 1 || cy == ny - 1)) sets.unite(id, border);
-      }
+    DisjointSets sets = face_components(nx, ny, label);
     std::map<int, int> size;  // root -> cells
     for (int c = 0; c < nx * ny; ++c) ++size[sets.find(c)];
     std::map<int, int> largest;  // face -> its largest root
     largest[0] = sets.find(border);
     for (const auto& [root, count] : size) {
-      if (root == border) continue;
+      if (root == largest[0]) continue;
       const int f = label(root % nx, root / nx);
       if (f == 0) continue;
       auto it = largest.find(f);

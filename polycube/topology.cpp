@@ -42,20 +42,8 @@ int require_closed_surface(const TriMesh& mesh) {
       throw MeshError("analyse_topology: face " + std::to_string(f) + " repeats a vertex");
   }
   const EdgeMap edges = build_edge_map(mesh.F);
-  int open = 0, nonmanifold = 0, misoriented = 0;
-  for (int e = 0; e < edges.num_edges(); ++e) {
-    if (edges.face_count[e] == 1) ++open;
-    if (edges.face_count[e] > 2) ++nonmanifold;
-    if (edges.face_count[e] != 2) continue;
-    // The two faces must run through the edge in opposite directions.
-    int forward = 0;
-    for (int k = 0; k < 2; ++k) {
-      const int f = edges.EF(e, k);
-      for (int i = 0; i < 3; ++i)
-        if (edges.FE(f, i) == e) forward += mesh.F(f, i) == edges.E(e, 0);
-    }
-    if (forward != 1) ++misoriented;
-  }
+  const EdgeDefects defects = edge_defects(mesh.F, edges);
+  const int open = defects.boundary, nonmanifold = defects.nonmanifold, misoriented = defects.misoriented;
   const int nonmanifold_vertices = nonmanifold == 0 ? count_nonmanifold_vertices(mesh.F, nv) : 0;
   const int unused = count_unreferenced_vertices(mesh.F, nv);
   const int components = connected_components(mesh.F, nv);

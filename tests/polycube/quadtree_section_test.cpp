@@ -1,10 +1,13 @@
 // approximate_section and sample_section: the quadtree approximation of a cross-section meets
 // d_a (or stops at max_level), keeps the topology of the contours (every face has one connected
 // cell set, faces no contour separates never touch, no diagonal touches), and honours edits.
+// coarsen_section undoes subdivisions beyond the d_a refinement and snap_section makes a section
+// follow its neighbour, where their checks allow.
 #include "polycube/quadtree_section.h"
 
 #include "polycube/quadtree_raster.h"
 #include "polycube/quadtree_sampled.h"
+#include "polycube/quadtree_simplify.h"
 #include "polycube/quadtree_topology.h"
 #include "polycube/slice.h"
 #include "support/generated_meshes.h"
@@ -14,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <map>
 #include <set>
 
 namespace polycube {
@@ -150,6 +154,146 @@ TEST(QuadtreeSection, SampledSectionFollowsTheContours) {
   EXPECT_NEAR(solid, sections.planes[0].face_area[region], 0.01 * sections.planes[0].face_area[region]);
   std::vector<char> mark;
   EXPECT_EQ(check_section_topology(sections.planes[0], sampled, mark), "");
+}
+
+// The annulus of a torus section, approximated for d_a, then every mixed cell subdivided three
+// more times as the stacking repairs would.
+struct OverRefined {
+  CrossSections sections;
+  QuadtreeSection plain, refined;
+};
+
+OverRefined over_refined_annulus() {
+  OverRefined r;
+  r.sections = sections_of(test::make_torus(1.0, 0.3, 96, 48), {0.05});
+  r.plain = approximate_section(r.sections, 0);
+  QuadtreeEdits edits;
+  r.refined = r.plain;
+  for (int round = 0; round < 3; ++round) {
+    for (const QuadLeaf& leaf : r.refined.leaves)
+      if (leaf.mixed) edits.splits.push_back(leaf.cell);
+    r.refined = approximate_section(r.sections, 0, edits);
+  }
+  return r;
+}
+
+std::map<QuadCell, int> labels_of(const std::vector<QuadLeaf>& leaves) {
+  std::map<QuadCell, int> labels;
+  for (const QuadLeaf& leaf : leaves) labels[leaf.cell] = leaf.face;
+  return labels;
+}
+
+TEST(QuadtreeCoarsening, UndoesTheSubdivisionsBeyondTheAccuracyRefinement) {
+  const OverRefined r = over_refined_annulus();
+  ASSERT_TRUE(r.plain.valid && r.refined.valid);
+  ASSERT_GT(r.refined.leaves.size(), 4 * r.plain.leaves.size());
+  for (const QuadLeaf& leaf : r.refined.leaves) EXPECT_LE(leaf.accuracy_level, r.plain.deepest_level);
+  const auto accept = [](const std::vector<QuadLeaf>&, std::vector<char>&) { return true; };
+  const CoarsenedSection coarsened = coarsen_section(r.sections.planes[0], r.refined.leaves, 0.3, 0, accept);
+  expect_partition(coarsened.leaves);
+  std::vector<char> mark;
+  EXPECT_EQ(check_section_topology(r.sections.planes[0], coarsened.leaves, mark), "");
+  EXPECT_GT(coarsened.merges, 0);
+  // A merged parent takes the face covering most of it, as the d_a refinement labelled it.
+  EXPECT_EQ(labels_of(coarsened.leaves), labels_of(r.plain.leaves));
+  // The coarsest level bounds the merges: a leaf coarser than it was there before.
+  const int coarsest = r.plain.deepest_level + 1;
+  const std::map<QuadCell, int> refined = labels_of(r.refined.leaves);
+  const CoarsenedSection bounded = coarsen_section(r.sections.planes[0], r.refined.leaves, 0.3, coarsest, accept);
+  for (const QuadLeaf& leaf : bounded.leaves)
+    EXPECT_TRUE(leaf.cell.level >= coarsest || refined.count(leaf.cell)) << leaf.cell.level;
+  EXPECT_LT(bounded.leaves.size(), r.refined.leaves.size());
+  EXPECT_GT(bounded.leaves.size(), coarsened.leaves.size());
+}
+
+// Whether two leaf sets label every point with x in [x0, x1) (grid units) alike; when `blame` is
+// given, it gets the leaves of `a` that do not.
+bool same_labels(const std::vector<QuadLeaf>& a, const std::vector<QuadLeaf>& b, int x0, int x1,
+                 std::vector<char>* blame = nullptr) {
+  const QuadRaster raster = rasterize({&a, &b});
+  bool same = true;
+  for (int cy = 0; cy < raster.ny(); ++cy)
+    for (int cx = 0; cx < raster.nx(); ++cx) {
+      if (raster.xs[cx] < x0 || raster.xs[cx + 1] > x1) continue;
+      const int la = raster.leaf_at(0, cx, cy), lb = raster.leaf_at(1, cx, cy);
+      if (a[la].face == b[lb].face) continue;
+      same = false;
+      if (blame) (*blame)[la] = 1;
+    }
+  return same;
+}
+
+TEST(QuadtreeCoarsening, KeepsWhatItsCheckRejects) {
+  const OverRefined r = over_refined_annulus();
+  const PlaneSection& section = r.sections.planes[0];
+  // Nothing accepted: only merges of siblings labelled alike, which change no label.
+  const auto reject = [](const std::vector<QuadLeaf>&, std::vector<char>&) { return false; };
+  const CoarsenedSection none = coarsen_section(section, r.refined.leaves, 0.3, 0, reject);
+  EXPECT_GT(none.undone, 0);
+  EXPECT_LT(none.leaves.size(), r.refined.leaves.size());
+  EXPECT_TRUE(same_labels(none.leaves, r.refined.leaves, 0, kQuadGridSize));
+  // Label changes in the left half are blamed: only the right half takes the labels of the d_a
+  // refinement again.
+  const int half = kQuadGridSize / 2;
+  const auto right_only = [&](const std::vector<QuadLeaf>& leaves, std::vector<char>& implicated) {
+    return same_labels(leaves, r.refined.leaves, 0, half, &implicated);
+  };
+  const CoarsenedSection right = coarsen_section(section, r.refined.leaves, 0.3, 0, right_only);
+  EXPECT_GT(right.merges, 0);
+  EXPECT_TRUE(same_labels(right.leaves, r.refined.leaves, 0, half));
+  EXPECT_TRUE(same_labels(right.leaves, r.plain.leaves, half, kQuadGridSize));
+  EXPECT_FALSE(same_labels(r.refined.leaves, r.plain.leaves, half, kQuadGridSize));
+}
+
+// Area of the cells solid in one of two leaf sets and not in the other.
+double solid_difference(const PlaneSection& a_section, const std::vector<QuadLeaf>& a, const PlaneSection& b_section,
+                        const std::vector<QuadLeaf>& b) {
+  const QuadRaster raster = rasterize({&a, &b});
+  double area = 0;
+  for (int cy = 0; cy < raster.ny(); ++cy)
+    for (int cx = 0; cx < raster.nx(); ++cx) {
+      const bool in_a = a_section.face_solid[a[raster.leaf_at(0, cx, cy)].face];
+      const bool in_b = b_section.face_solid[b[raster.leaf_at(1, cx, cy)].face];
+      if (in_a != in_b)
+        area += double(raster.xs[cx + 1] - raster.xs[cx]) * (raster.ys[cy + 1] - raster.ys[cy]) /
+                (double(kQuadGridSize) * kQuadGridSize);
+    }
+  return area;
+}
+
+TEST(QuadtreeSnapping, FollowsTheNeighbourWithinDa) {
+  // Two sections of a tilted torus: the annulus moves sideways from one plane to the next.
+  TriMesh mesh = test::make_torus(1.0, 0.3, 96, 48);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  mesh.V = (mesh.V * R.transpose()).eval();
+  const CrossSections sections = sections_of(mesh, {0.0, 0.06});
+  const PlaneSection &lower = sections.planes[0], &upper = sections.planes[1];
+  QuadtreeOptions options;
+  options.max_level = 6;
+  const QuadtreeSection a = approximate_section(sections, 0, {}, options);
+  const QuadtreeSection b = approximate_section(sections, 1, {}, options);
+  ASSERT_TRUE(a.valid && b.valid);
+  const auto accept = [](const std::vector<QuadLeaf>&, std::vector<char>&) { return true; };
+  const CoarsenedSection snapped =
+      snap_section(upper, b.leaves, 0.3, 0, SnapNeighbour{&lower, &a.leaves}, SnapNeighbour{}, true, accept);
+  EXPECT_GT(snapped.merges, 0);
+  expect_partition(snapped.leaves);
+  std::vector<char> mark;
+  EXPECT_EQ(check_section_topology(upper, snapped.leaves, mark), "");
+  EXPECT_LT(solid_difference(lower, a.leaves, upper, snapped.leaves),
+            solid_difference(lower, a.leaves, upper, b.leaves));
+  // Every region stays within d_a (or what it had), measured like approximate_section does.
+  const std::vector<double> before = region_errors(upper, b.leaves), after = region_errors(upper, snapped.leaves);
+  for (int f = 0; f < upper.num_faces(); ++f) {
+    EXPECT_NEAR(before[f], b.region_error[f], 1e-12) << "face " << f;
+    EXPECT_LE(after[f], std::max(0.3, before[f]) + 1e-9) << "face " << f;
+  }
+  // Nothing the check rejects is kept.
+  const auto reject = [](const std::vector<QuadLeaf>&, std::vector<char>&) { return false; };
+  const CoarsenedSection none =
+      snap_section(upper, b.leaves, 0.3, 0, SnapNeighbour{&lower, &a.leaves}, SnapNeighbour{}, true, reject);
+  EXPECT_EQ(none.merges, 0);
+  EXPECT_EQ(labels_of(none.leaves), labels_of(b.leaves));
 }
 
 }  // namespace
