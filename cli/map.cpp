@@ -42,26 +42,9 @@ struct MapOptions {
   PolycubeOptions polycube;
 };
 
-// A distinct, light colour per index (golden-ratio hue steps), RGB in [0,1].
-Eigen::Vector3d index_colour(int index) {
-  const double hue = std::fmod(index * 0.6180339887498949, 1.0) * 6.0;
-  const double s = 0.55, v = 0.95;
-  const int sector = static_cast<int>(hue) % 6;
-  const double f = hue - std::floor(hue);
-  const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
-  switch (sector) {
-    case 0: return {v, t, p};
-    case 1: return {q, v, p};
-    case 2: return {p, v, t};
-    case 3: return {p, q, v};
-    case 4: return {t, p, v};
-    default: return {v, p, q};
-  }
-}
-
 Eigen::MatrixX3d piece_colours(const SlicedMesh& sliced) {
   Eigen::MatrixX3d rgb(sliced.mesh.num_faces(), 3);
-  for (int f = 0; f < sliced.mesh.num_faces(); ++f) rgb.row(f) = index_colour(sliced.face_piece[f]);
+  for (int f = 0; f < sliced.mesh.num_faces(); ++f) rgb.row(f) = distinct_colour(sliced.face_piece[f]);
   return rgb;
 }
 
@@ -92,7 +75,7 @@ void write_polycube_preview(const std::string& path, const PolycubeResult& resul
   for (size_t m = 0; m < result.piece_match.size(); ++m) model_piece_of[result.piece_match[m]] = static_cast<int>(m);
   const TriMesh& cube = result.polycube_sliced.mesh;
   Eigen::MatrixX3d cube_rgb(cube.num_faces(), 3);
-  for (int f = 0; f < cube.num_faces(); ++f) cube_rgb.row(f) = index_colour(model_piece_of[result.polycube_sliced.face_piece[f]]);
+  for (int f = 0; f < cube.num_faces(); ++f) cube_rgb.row(f) = distinct_colour(model_piece_of[result.polycube_sliced.face_piece[f]]);
   RenderItem model, polycube;
   model.mesh = &result.model_sliced.mesh;
   model.face_rgb = &model_rgb;

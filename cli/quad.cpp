@@ -3,7 +3,9 @@
 #include "cli/commands.h"
 #include "cli/mesh_input.h"
 
+#include "applications/preview/render.h"
 #include "applications/quad/quad_remesh.h"
+#include "formats/image_io.h"
 #include "formats/atomic_file.h"
 #include "formats/mesh_io.h"
 #include "polycube/align.h"
@@ -33,6 +35,7 @@ struct QuadCommandOptions {
   std::string map_dir;
   int smooth = 0;
   std::string report_path;
+  std::string preview_path;
   std::string align = "auto";
   TopologyOptions topology;
   PolycubeOptions polycube;
@@ -124,7 +127,7 @@ nlohmann::json quality_json(const QuadQuality& q) {
 int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   const Progress progress(global);
   // Fail before the long stages when the outputs cannot go where asked.
-  for (const std::string& path : {options.output, options.report_path}) {
+  for (const std::string& path : {options.output, options.report_path, options.preview_path}) {
     if (path.empty()) continue;
     const std::filesystem::path parent = std::filesystem::absolute(path).parent_path();
     if (!std::filesystem::is_directory(parent)) throw OutputError("cannot write " + path + ": no directory " + parent.string());
@@ -211,6 +214,20 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   seconds["total"] = progress.elapsed_seconds();
   progress.stage("done", "wrote " + options.output);
 
+  if (!options.preview_path.empty()) {
+    // Each quad one flat colour, from the 3/4 view in front and from behind.
+    const TriMesh triangles = triangulate_quads(result.mesh);
+    Eigen::MatrixX3d rgb(triangles.num_faces(), 3);
+    for (int f = 0; f < triangles.num_faces(); ++f) rgb.row(f) = distinct_colour(f / 2);
+    RenderItem front;
+    front.mesh = &triangles;
+    front.face_rgb = &rgb;
+    front.smooth = false;
+    RenderItem back = front;
+    back.view_direction = {-front.view_direction.x(), -front.view_direction.y(), front.view_direction.z()};
+    write_image(options.preview_path, render_tiles({front, back}));
+    progress.stage("done", "wrote " + options.preview_path);
+  }
   if (!options.report_path.empty()) {
     const PolycubeGrid& grid = result.grid;
     report["grid"] = {{"quads", grid.mesh.num_quads()},
@@ -257,6 +274,7 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
       ->capture_default_str()
       ->check(CLI::Range(0, 10000));
   command->add_option("--report", options->report_path, "Write the quality report as JSON to this file");
+  command->add_option("--preview", options->preview_path, "Write a picture of the quads (PNG), front and back");
   command->add_option("--align", options->align, "Orientation search as for `map` (auto | none; not with --map)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "none"}));

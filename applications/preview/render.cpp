@@ -159,4 +159,20 @@ Image render_tiles(const std::vector<RenderItem>& items, const RenderOptions& op
   return image;
 }
 
+Eigen::Vector3d distinct_colour(int index) {
+  const double hue = std::fmod(index * 0.6180339887498949, 1.0) * 6.0;
+  const double s = 0.55, v = 0.95;
+  const int sector = static_cast<int>(hue) % 6;
+  const double f = hue - std::floor(hue);
+  const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  switch (sector) {
+    case 0: return {v, t, p};
+    case 1: return {q, v, p};
+    case 2: return {p, v, t};
+    case 3: return {p, q, v};
+    case 4: return {t, p, v};
+    default: return {v, p, q};
+  }
+}
+
 }  // namespace polycube

@@ -41,6 +41,10 @@ struct RenderOptions {
   Eigen::Vector3d background{1, 1, 1};
 };
 
+// A light colour per index, neighbouring indices far apart in hue (golden-ratio steps); RGB in
+// [0, 1]. For colouring pieces, patches, quads.
+Eigen::Vector3d distinct_colour(int index);
+
 // Renders each item into its own tile, left to right, each framed to fill its tile
 // (orthographic projection). Returns an RGB image.
 Image render_tiles(const std::vector<RenderItem>& items, const RenderOptions& options = {});
