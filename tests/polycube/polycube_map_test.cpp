@@ -125,6 +125,31 @@ INSTANTIATE_TEST_SUITE_P(Meshes, PolycubeMapOnMeshes,
                            return s;
                          });
 
+// Surfaces no one tuned for: generated genus 5 and 11. Every disk embeds, φ⁻¹ ∘ φ is the identity
+// and the images lie on the surfaces.
+TEST(PolycubeMap, GeneratedHighGenusSurfaces) {
+  for (int g : {5, 11}) {
+    const TriMesh model = make_genus_surface(g, 40);
+    const Pipeline p = run(model);
+    EXPECT_EQ(p.polycube.genus, g);
+    for (const PieceMapStats& s : p.map.pieces) {
+      EXPECT_EQ(s.flipped_model_disk + s.flipped_polycube_disk, 0) << "genus " << g << " piece " << s.model_piece;
+    }
+    const TriMesh& P = p.polycube.polycube.mesh;
+    const MapAudit audit = audit_map(model, P, p.map.polycube_on_model_xyz, p.map.model_on_polycube_xyz);
+    EXPECT_LT(audit.polycube_to_model.max_distance, 1e-9);
+    EXPECT_LT(audit.model_to_polycube.max_distance, 1e-9);
+    const double diagonal = bounding_box(model.V).diagonal();
+    std::mt19937 rng(11);
+    double worst = 0;
+    for (int k = 0; k < 200; ++k) {
+      const SurfacePoint x = random_point(P, rng);
+      worst = std::max(worst, (surface_position(P, p.map.to_polycube(p.map.to_model(x))) - surface_position(P, x)).norm());
+    }
+    EXPECT_LT(worst / diagonal, 1e-7) << "genus " << g;
+  }
+}
+
 // On a finely meshed model the image of P covers the model's area (the 2 %).
 TEST(PolycubeMap, ImageOfPolycubeCoversTheModel) {
   const TriMesh model = load_mesh_file(example_path("rocker-arm.obj"));
