@@ -90,7 +90,7 @@ def main():
             continue
         m = r.get("map", {})
         s = r["seconds"]
-        stages = " / ".join("%.2f" % s.get(k, 0) for k in ("topology", "polycube", "map"))
+        stages = " / ".join("%.2f" % s.get(k, 0) for k in ("align", "topology", "polycube", "map", "smooth"))
         pm, mp = m.get("polycube_to_model", {}), m.get("model_to_polycube", {})
         rows.append("| %s | %d | %d | %s | %s | %d | %.3f | %.3f | %d / %d | %.4f | %s | %.2f | %.0f | ok | %s |" % (
             name, r["input"]["faces"], r["input"]["genus"], r["parameters"]["dz"], r["parameters"]["da"],
@@ -98,7 +98,7 @@ def main():
             pm.get("flipped", -1), mp.get("flipped", -1), pm.get("area_ratio", float("nan")), stages, s["total"], rss, paper_cols))
         print(rows[-1], file=sys.stderr)
     header = [
-        "| mesh | triangles | genus | d_z | d_a | corners | ε_angle | ε_area | flipped P→M / M→P | image area / model area | seconds topology / polycube / map | total s | peak RSS MB | result | paper ε_angle / ε_area / time |",
+        "| mesh | triangles | genus | d_z | d_a | corners | ε_angle | ε_area | flipped P→M / M→P | image area / model area | seconds align / topology / polycube / map / smooth | total s | peak RSS MB | result | paper ε_angle / ε_area / time |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     with open(a.output, "w") as f:

@@ -11,6 +11,7 @@
 #include "polycube/errors.h"
 #include "polycube/polycube_build.h"
 #include "polycube/map_audit.h"
+#include "polycube/map_smoothing.h"
 #include "polycube/polycube_map.h"
 #include "polycube/topology.h"
 
@@ -38,6 +39,7 @@ struct MapOptions {
   std::string output_dir;
   std::string stage = kStages.back();
   std::string align = "auto";
+  int smooth_sweeps = 10;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -90,10 +92,10 @@ void write_polycube_preview(const std::string& path, const PolycubeResult& resul
 // The map at a glance: the model with a checkerboard carried from P through φ⁻¹ beside P with the
 // same checkers, both shaded, from the same 3/4 view and at the same scale. Checkers are cubes of
 // 1/24 of P's diagonal, shifted off P's faces so that no face lies on a cell boundary.
-void write_map_preview(const std::string& path, const TriMesh& model, const Polycube& polycube, const PolycubeMap& map) {
+void write_map_preview(const std::string& path, const TriMesh& model, const Polycube& polycube, const Eigen::MatrixX3d& model_on_polycube) {
   const double cell = bounding_box(polycube.mesh.V).diagonal() / 24;
   const Eigen::RowVector3d shift = Eigen::RowVector3d::Constant(0.3819660112501051 * cell);
-  const Eigen::MatrixX3d model_coords = map.model_on_polycube_xyz.rowwise() + shift;
+  const Eigen::MatrixX3d model_coords = model_on_polycube.rowwise() + shift;
   const Eigen::MatrixX3d polycube_coords = polycube.mesh.V.rowwise() + shift;
   RenderItem m, p;
   m.mesh = &model;
@@ -199,6 +201,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   const SlicedMesh* model_pieces = &topology.sliced;
   std::optional<PolycubeResult> polycube;
   std::optional<PolycubeMap> map;
+  Eigen::MatrixX3d on_model_xyz, on_polycube_xyz;  // the map at the vertices, smoothed when asked
   if (runs(options.stage, "polycube")) {
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
     polycube = alignment.polycube ? std::move(*alignment.polycube) : build_polycube(model, topology, options.polycube);
@@ -228,11 +231,39 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       slits += p.slits;
       min_disk_area = std::min(min_disk_area, p.min_disk_area);
     }
-    const MapAudit audit = audit_map(model, polycube->polycube.mesh, map->polycube_on_model_xyz, map->model_on_polycube_xyz);
     auto direction_json = [](const MapDirectionAudit& a) {
       return nlohmann::json{{"triangles", a.triangles}, {"flipped", a.flipped}, {"degenerate", a.degenerate},
                             {"max_distance", a.max_distance}, {"area_ratio", a.area_ratio}, {"ok", a.ok}};
     };
+    // Stage 5 (§3.5): smoothing that never adds a flip in either direction.
+    on_model_xyz = map->polycube_on_model_xyz;
+    on_polycube_xyz = map->model_on_polycube_xyz;
+    nlohmann::json smoothing = nullptr;
+    if (options.smooth_sweeps > 0) {
+      const MapAudit before = audit_map(model, polycube->polycube.mesh, on_model_xyz, on_polycube_xyz);
+      progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded (" + std::to_string(before.polycube_to_model.flipped) +
+                                   " / " + std::to_string(before.model_to_polycube.flipped) + " flipped before)");
+      MapSmoothingOptions smooth_options;
+      smooth_options.sweeps = options.smooth_sweeps;
+      const MapSmoothingResult smoothed = smooth_map(model, polycube->polycube, *map, smooth_options);
+      on_model_xyz = smoothed.polycube_on_model_xyz;
+      on_polycube_xyz = smoothed.model_on_polycube_xyz;
+      seconds["smooth"] = smoothed.seconds;
+      smoothing = {{"sweeps", smoothed.sweeps},
+                   {"rounds", smoothed.rounds},
+                   {"moves", smoothed.moves},
+                   {"rejected", smoothed.rejected},
+                   {"frozen_polycube_vertices", smoothed.frozen},
+                   {"relocated_model_vertices", smoothed.relocated},
+                   {"seconds", smoothed.seconds},
+                   {"before", {{"polycube_to_model", direction_json(before.polycube_to_model)},
+                               {"model_to_polycube", direction_json(before.model_to_polycube)},
+                               {"eps_angle", before.distortion.eps_angle},
+                               {"eps_area", before.distortion.eps_area},
+                               {"angle_p95", before.distortion.angle_p95},
+                               {"angle_max", before.distortion.angle_max}}}};
+    }
+    const MapAudit audit = audit_map(model, polycube->polycube.mesh, on_model_xyz, on_polycube_xyz);
     report["map"] = {{"contours", map->contours},
                      {"pieces", map->pieces.size()},
                      {"slits", slits},
@@ -243,18 +274,26 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"polycube_to_model", direction_json(audit.polycube_to_model)},
                      {"model_to_polycube", direction_json(audit.model_to_polycube)},
                      {"eps_angle", audit.distortion.eps_angle},
-                     {"eps_area", audit.distortion.eps_area}};
+                     {"eps_area", audit.distortion.eps_area},
+                     {"angle_p50", audit.distortion.angle_p50},
+                     {"angle_p95", audit.distortion.angle_p95},
+                     {"angle_max", audit.distortion.angle_max},
+                     {"area_p95", audit.distortion.area_p95},
+                     {"area_max", audit.distortion.area_max},
+                     {"smoothing", smoothing}};
     TriMesh on_model = polycube->polycube.mesh;
-    on_model.V = to_input(map->polycube_on_model_xyz);
+    on_model.V = to_input(on_model_xyz);
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
     write_mesh(on_model_path, on_model);
     outputs.push_back(on_model_path);
     TriMesh on_polycube = prepared.mesh;
-    on_polycube.V = to_input(map->model_on_polycube_xyz);
+    on_polycube.V = to_input(on_polycube_xyz);
     const std::string on_polycube_path = (dir / "model_on_polycube.obj").string();
     write_mesh(on_polycube_path, on_polycube);
     outputs.push_back(on_polycube_path);
-    progress.stage("map", std::to_string(flipped_disks) + " flipped disk triangles");
+    progress.stage("map", std::to_string(flipped_disks) + " flipped disk triangles; " + std::to_string(audit.polycube_to_model.flipped) + " / " +
+                              std::to_string(audit.model_to_polycube.flipped) + " flipped image triangles (P to M / M to P), eps_angle " +
+                              std::to_string(audit.distortion.eps_angle));
   }
 
   const std::string pieces_path = (dir / "pieces.ply").string();
@@ -264,7 +303,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   outputs.push_back(pieces_path);
   const std::string preview_path = (dir / "preview.png").string();
   if (map)
-    write_map_preview(preview_path, model, polycube->polycube, *map);
+    write_map_preview(preview_path, model, polycube->polycube, on_polycube_xyz);
   else if (polycube)
     write_polycube_preview(preview_path, *polycube);
   else
@@ -303,6 +342,10 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "fewest corners; none: keep the input's orientation")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "none"}));
+  command->add_option("--smooth-sweeps", options->smooth_sweeps,
+                      "Sweeps per round of the map's smoothing (paper §3.5; never adds a flipped triangle); 0: no smoothing")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
   command->add_option("--stage", options->stage, "Stop after this stage")
       ->capture_default_str()
       ->check(CLI::IsMember(kStages));

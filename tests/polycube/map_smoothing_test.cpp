@@ -1,0 +1,186 @@
+// smooth_map (§3.5): on the test meshes, smoothing never flips more image triangles in either
+// direction than the input map (judged by the independent audit), keeps every image on the other
+// surface, lowers the angle distortion, and does not depend on the number of threads.
+#include "polycube/map_smoothing.h"
+
+#include "polycube/map_audit.h"
+#include "polycube/polycube_build.h"
+#include "polycube/polycube_map.h"
+#include "polycube/topology.h"
+#include "support/generated_meshes.h"
+#include "support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace polycube {
+namespace {
+
+using namespace test;
+
+struct Pipeline {
+  TriMesh model;
+  PolycubeResult polycube;
+  PolycubeMap map;
+};
+
+// The pipeline up to stage 4 once per mesh (several tests share it).
+const Pipeline& pipeline(const std::string& name) {
+  static std::map<std::string, std::unique_ptr<Pipeline>> cache;
+  auto& slot = cache[name];
+  if (!slot) {
+    slot = std::make_unique<Pipeline>();
+    if (name == "generated-genus-5") slot->model = make_genus_surface(5, 40);
+    else if (name == "rocker-arm.obj") slot->model = load_mesh_file(example_path(name));
+    else slot->model = load_test_mesh(name);
+    slot->polycube = build_polycube(slot->model, analyse_topology(slot->model));
+    slot->map = build_polycube_map(slot->model, slot->polycube);
+  }
+  return *slot;
+}
+
+int bad(const MapDirectionAudit& a) { return a.flipped + a.degenerate; }
+
+class MapSmoothingOnMeshes : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(MapSmoothingOnMeshes, NoNewFlipsImagesOnSurfacesLowerAngleDistortion) {
+  const std::string name = GetParam();
+  const Pipeline& p = pipeline(name);
+  const TriMesh& P = p.polycube.polycube.mesh;
+  const MapSmoothingResult r = smooth_map(p.model, p.polycube.polycube, p.map);
+
+  ASSERT_EQ(r.polycube_on_model.size(), static_cast<size_t>(P.num_vertices()));
+  ASSERT_EQ(r.model_on_polycube.size(), static_cast<size_t>(p.model.num_vertices()));
+  ASSERT_EQ(r.polycube_on_model_xyz.rows(), P.num_vertices());
+  ASSERT_EQ(r.model_on_polycube_xyz.rows(), p.model.num_vertices());
+  // The surface points and the positions say the same.
+  for (int v = 0; v < P.num_vertices(); ++v) {
+    ASSERT_GE(r.polycube_on_model[v].face, 0);
+    ASSERT_LT(r.polycube_on_model[v].face, p.model.num_faces());
+    EXPECT_NEAR(r.polycube_on_model[v].bary.sum(), 1.0, 1e-12);
+    EXPECT_GE(r.polycube_on_model[v].bary.minCoeff(), 0.0);
+    EXPECT_LT((surface_position(p.model, r.polycube_on_model[v]).transpose() - r.polycube_on_model_xyz.row(v)).norm(), 1e-12);
+  }
+  for (int w = 0; w < p.model.num_vertices(); ++w) {
+    ASSERT_GE(r.model_on_polycube[w].face, 0);
+    ASSERT_LT(r.model_on_polycube[w].face, P.num_faces());
+    EXPECT_NEAR(r.model_on_polycube[w].bary.sum(), 1.0, 1e-12);
+    EXPECT_GE(r.model_on_polycube[w].bary.minCoeff(), 0.0);
+  }
+
+  const MapAudit before = audit_map(p.model, P, p.map.polycube_on_model_xyz, p.map.model_on_polycube_xyz);
+  const MapAudit after = audit_map(p.model, P, r.polycube_on_model_xyz, r.model_on_polycube_xyz);
+  // Never more flipped (or degenerate) image triangles than the input, in either direction.
+  EXPECT_LE(bad(after.polycube_to_model), bad(before.polycube_to_model)) << name;
+  EXPECT_LE(bad(after.model_to_polycube), bad(before.model_to_polycube)) << name;
+  // The result reports the audit's counts.
+  EXPECT_EQ(r.flipped_before[0], bad(before.polycube_to_model)) << name;
+  EXPECT_EQ(r.flipped_before[1], bad(before.model_to_polycube)) << name;
+  EXPECT_EQ(r.flipped_after[0], bad(after.polycube_to_model)) << name;
+  EXPECT_EQ(r.flipped_after[1], bad(after.model_to_polycube)) << name;
+  // Images on the other surface, to rounding.
+  EXPECT_LT(after.polycube_to_model.max_distance, 1e-9) << name;
+  EXPECT_LT(after.model_to_polycube.max_distance, 1e-9) << name;
+  // Smoother: lower angle distortion.
+  EXPECT_LT(after.distortion.eps_angle, before.distortion.eps_angle) << name;
+  EXPECT_GE(after.distortion.eps_angle, 1.0) << name;
+  EXPECT_GT(r.moves, 0) << name;
+  EXPECT_GE(r.rounds, 1) << name;
+  EXPECT_GT(r.seconds, 0) << name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Meshes, MapSmoothingOnMeshes,
+                         ::testing::Values("sphere.off", "eight.off", "knot.off", "helmet.off", "double-torus-example.off", "rocker-arm.obj",
+                                           "generated-genus-5"),
+                         [](const auto& info) {
+                           std::string s = info.param.substr(0, info.param.find('.'));
+                           for (char& ch : s)
+                             if (ch == '-') ch = '_';
+                           return s;
+                         });
+
+// Every closed mesh of tests/data, the coarse and tangled ones included (where the guard may keep
+// much of the input): no direction gets worse, images stay on the surfaces, the angle distortion
+// does not grow.
+TEST(MapSmoothing, NeverWorseOnAnyClosedTestMesh) {
+  for (const auto& [name, genus] : closed_test_meshes()) {
+    const Pipeline& p = pipeline(name);
+    const TriMesh& P = p.polycube.polycube.mesh;
+    const MapSmoothingResult r = smooth_map(p.model, p.polycube.polycube, p.map);
+    const MapAudit before = audit_map(p.model, P, p.map.polycube_on_model_xyz, p.map.model_on_polycube_xyz);
+    const MapAudit after = audit_map(p.model, P, r.polycube_on_model_xyz, r.model_on_polycube_xyz);
+    EXPECT_LE(bad(after.polycube_to_model), bad(before.polycube_to_model)) << name;
+    EXPECT_LE(bad(after.model_to_polycube), bad(before.model_to_polycube)) << name;
+    EXPECT_LT(after.polycube_to_model.max_distance, 1e-9) << name;
+    EXPECT_LT(after.model_to_polycube.max_distance, 1e-9) << name;
+    EXPECT_LE(after.distortion.eps_angle, before.distortion.eps_angle) << name;
+    (void)genus;
+  }
+}
+
+// Vertices of one colour move in parallel but never see each other's moves: one thread or two,
+// the same map.
+TEST(MapSmoothing, SameResultOnAnyNumberOfThreads) {
+  const Pipeline& p = pipeline("knot.off");
+  MapSmoothingOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const MapSmoothingResult a = smooth_map(p.model, p.polycube.polycube, p.map, one);
+  const MapSmoothingResult b = smooth_map(p.model, p.polycube.polycube, p.map, two);
+  EXPECT_EQ(a.moves, b.moves);
+  EXPECT_EQ(a.polycube_on_model_xyz, b.polycube_on_model_xyz);
+  EXPECT_EQ(a.model_on_polycube_xyz, b.model_on_polycube_xyz);
+}
+
+// No sweeps: nothing moves, and the input map comes back as it was.
+TEST(MapSmoothing, NoSweepsReturnsTheInput) {
+  const Pipeline& p = pipeline("sphere.off");
+  MapSmoothingOptions options;
+  options.sweeps = 0;
+  const MapSmoothingResult r = smooth_map(p.model, p.polycube.polycube, p.map, options);
+  EXPECT_EQ(r.moves, 0);
+  EXPECT_EQ(r.relocated, 0);
+  EXPECT_EQ(r.polycube_on_model_xyz, p.map.polycube_on_model_xyz);
+  EXPECT_EQ(r.model_on_polycube_xyz, p.map.model_on_polycube_xyz);
+  EXPECT_EQ(r.flipped_after, r.flipped_before);
+}
+
+// More sweeps, smoother: the angle distortion keeps falling while the flips stay within bounds.
+TEST(MapSmoothing, MoreSweepsLowerAngleDistortionFurther) {
+  const Pipeline& p = pipeline("rocker-arm.obj");
+  const TriMesh& P = p.polycube.polycube.mesh;
+  double previous = audit_map(p.model, P, p.map.polycube_on_model_xyz, p.map.model_on_polycube_xyz).distortion.eps_angle;
+  for (int sweeps : {2, 10, 30}) {
+    MapSmoothingOptions options;
+    options.sweeps = sweeps;
+    const MapSmoothingResult r = smooth_map(p.model, p.polycube.polycube, p.map, options);
+    const MapAudit audit = audit_map(p.model, P, r.polycube_on_model_xyz, r.model_on_polycube_xyz);
+    EXPECT_LT(audit.distortion.eps_angle, previous) << sweeps << " sweeps";
+    EXPECT_LE(r.flipped_after[0], r.flipped_before[0]);
+    EXPECT_LE(r.flipped_after[1], r.flipped_before[1]);
+    previous = audit.distortion.eps_angle;
+  }
+}
+
+TEST(MapSmoothing, RejectsMismatchedInput) {
+  const Pipeline& p = pipeline("sphere.off");
+  PolycubeMap truncated = p.map;
+  truncated.polycube_on_model.pop_back();
+  EXPECT_THROW(smooth_map(p.model, p.polycube.polycube, truncated), std::invalid_argument);
+  PolycubeMap bad_face = p.map;
+  bad_face.model_on_polycube[0].face = p.polycube.polycube.mesh.num_faces();
+  EXPECT_THROW(smooth_map(p.model, p.polycube.polycube, bad_face), std::invalid_argument);
+  MapSmoothingOptions options;
+  options.rounds = 0;
+  EXPECT_THROW(smooth_map(p.model, p.polycube.polycube, p.map, options), std::invalid_argument);
+  options.rounds = 1;
+  options.sweeps = -1;
+  EXPECT_THROW(smooth_map(p.model, p.polycube.polycube, p.map, options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace polycube
