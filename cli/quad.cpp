@@ -10,6 +10,7 @@
 #include "formats/mesh_io.h"
 #include "polycube/align.h"
 #include "polycube/errors.h"
+#include "polycube/map_smoothing.h"
 #include "polycube/polycube_build.h"
 #include "polycube/polycube_map.h"
 #include "polycube/topology.h"
@@ -37,6 +38,7 @@ struct QuadCommandOptions {
   std::string report_path;
   std::string preview_path;
   std::string align = "auto";
+  int smooth_map_sweeps = 0;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -190,10 +192,21 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     map = build_polycube_map(aligned, *polycube);
     seconds["map"] = map->seconds;
     polycube_mesh = &polycube->polycube.mesh;
-    to_model = [&aligned, &map, rotation](const SurfacePoint& p) -> Eigen::Vector3d {
-      return rotation.transpose() * surface_position(aligned, map->to_model(p));
-    };
-    remesh.carry.threads = 0;  // PolycubeMap::to_model only reads
+    if (options.smooth_map_sweeps > 0) {
+      // The smoothed map (as `map` writes it): its images at P's vertices, interpolated in P's
+      // triangles and placed on the model.
+      progress.stage("smooth", "harmonic relaxation of the map, flips guarded");
+      MapSmoothingOptions smooth_options;
+      smooth_options.sweeps = options.smooth_map_sweeps;
+      const MapSmoothingResult smoothed = smooth_map(aligned, polycube->polycube, *map, smooth_options);
+      seconds["smooth_map"] = smoothed.seconds;
+      to_model = projected_map(vertex_image_map(*polycube_mesh, smoothed.polycube_on_model_xyz * rotation), projector);
+    } else {
+      to_model = [&aligned, &map, rotation](const SurfacePoint& p) -> Eigen::Vector3d {
+        return rotation.transpose() * surface_position(aligned, map->to_model(p));
+      };
+    }
+    remesh.carry.threads = 0;  // both maps only read
   }
 
   remesh.grid.cell_size = options.cell_size;
@@ -275,6 +288,9 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
       ->check(CLI::Range(0, 10000));
   command->add_option("--report", options->report_path, "Write the quality report as JSON to this file");
   command->add_option("--preview", options->preview_path, "Write a picture of the quads (PNG), front and back");
+  command->add_option("--smooth-sweeps", options->smooth_map_sweeps, "Sweeps of the map smoothing before carrying the grid (as `map --smooth-sweeps`; 0: the unsmoothed map; not with --map)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
   command->add_option("--align", options->align, "Orientation search as for `map` (auto | none; not with --map)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "none"}));
