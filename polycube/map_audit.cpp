@@ -1,9 +1,6 @@
 #include "polycube/map_audit.h"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Simple_cartesian.h>
+#include "polycube/triangle_tree.h"
 
 #include <Eigen/Geometry>
 
@@ -18,12 +15,7 @@ namespace polycube {
 
 namespace {
 
-using Kernel = CGAL::Simple_cartesian<double>;
-using Point = Kernel::Point_3;
-using Triangle = Kernel::Triangle_3;
-using Iterator = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, Iterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+using namespace triangle_tree;
 
 // Image triangles at or below this fraction of the target area are degenerate.
 constexpr double kDegenerateArea = 1e-14;

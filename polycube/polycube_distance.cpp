@@ -1,9 +1,6 @@
 #include "polycube/polycube_distance.h"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Simple_cartesian.h>
+#include "polycube/triangle_tree.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,21 +12,7 @@ namespace polycube {
 
 namespace {
 
-using Kernel = CGAL::Simple_cartesian<double>;
-using Point = Kernel::Point_3;
-using Triangle = Kernel::Triangle_3;
-using Iterator = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, Iterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
-
-std::vector<Triangle> triangles_of(const TriMesh& mesh) {
-  std::vector<Triangle> triangles;
-  triangles.reserve(mesh.num_faces());
-  auto point = [&](int v) { return Point(mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)); };
-  for (int f = 0; f < mesh.num_faces(); ++f)
-    triangles.emplace_back(point(mesh.F(f, 0)), point(mesh.F(f, 1)), point(mesh.F(f, 2)));
-  return triangles;
-}
+using namespace triangle_tree;
 
 // Vertices plus area-weighted random points of the surface.
 std::vector<Point> samples_of(const TriMesh& mesh, int count, unsigned seed) {
