@@ -162,11 +162,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   double align_seconds = 0;
   if (options.align == "auto" && options.stage != "topology") {
     const double align_start = progress.elapsed_seconds();
-    progress.stage("align", "scoring 6 orientations (input frame, principal axes) by polycube corners");
+    progress.stage("align", "6 orientations (input frame, principal axes): polycubes, then maps of the 3 with fewest corners, scored by flips");
     alignment = choose_alignment(prepared.mesh, options.topology, options.polycube);
     nlohmann::json candidates = nlohmann::json::array();
     for (const AlignmentCandidate& c : alignment.candidates)
-      candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"seconds", c.seconds}, {"error", c.error}});
+      candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle},
+                            {"seconds", c.seconds}, {"error", c.error}});
     report["alignment"]["candidates"] = candidates;
     align_seconds = progress.elapsed_seconds() - align_start;
     if (alignment.chosen >= 0) {
@@ -218,7 +219,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   }
   if (runs(options.stage, "map")) {
     progress.stage("map", "boundary maps, slits, disk maps of " + std::to_string(polycube->piece_match.size()) + " piece pairs");
-    map = build_polycube_map(model, *polycube);
+    map = alignment.map ? std::move(*alignment.map) : build_polycube_map(model, *polycube);
     seconds["map"] = map->seconds;
     int flipped_disks = 0, ricci_pieces = 0, ricci_iterations = 0, flat_slits = 0, slits = 0;
     double ricci_residual = 0, min_disk_area = INFINITY;

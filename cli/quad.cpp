@@ -170,7 +170,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     Alignment alignment;
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
     if (options.align == "auto") {
-      progress.stage("align", "scoring 6 orientations (input frame, principal axes) by polycube corners");
+      progress.stage("align", "6 orientations (input frame, principal axes): polycubes, then maps of the 3 with fewest corners, scored by flips");
       alignment = choose_alignment(model, options.topology, options.polycube);
       if (alignment.chosen >= 0) {
         rotation = alignment.rotation;
@@ -189,7 +189,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     progress.stage("polycube", std::to_string(polycube->polycube.corners.size()) + " corners, " +
                                    std::to_string(polycube->polycube.faces.size()) + " faces");
     progress.stage("map", "bijection between the polycube and the model");
-    map = build_polycube_map(aligned, *polycube);
+    map = alignment.map ? std::move(*alignment.map) : build_polycube_map(aligned, *polycube);
     seconds["map"] = map->seconds;
     polycube_mesh = &polycube->polycube.mesh;
     if (options.smooth_map_sweeps > 0) {

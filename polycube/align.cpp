@@ -1,6 +1,7 @@
 #include "polycube/align.h"
 
 #include "polycube/errors.h"
+#include "polycube/map_audit.h"
 #include "polycube/parallel.h"
 
 #include <Eigen/Eigenvalues>
@@ -9,7 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <chrono>
-#include <mutex>
+#include <tuple>
 #include <numeric>
 
 namespace polycube {
@@ -78,30 +79,66 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   scoring.max_inserted_planes = std::min(scoring.max_inserted_planes, options.max_inserted_planes);
   scoring.max_plane_cells = std::min(scoring.max_plane_cells, options.max_plane_cells);
   scoring.max_repair_level = std::min(scoring.max_repair_level, options.max_repair_level);
-  std::mutex lock;
-  std::vector<int> order(out.candidates.size());
+  const int n = static_cast<int>(out.candidates.size());
+  std::vector<std::shared_ptr<TopologyResult>> topologies(n);
+  std::vector<std::shared_ptr<PolycubeResult>> polycubes(n);
+  std::vector<TriMesh> turned(n);
+  std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
   parallel_for_each(order, options.threads, "orientation", [&](int i) {
     AlignmentCandidate& c = out.candidates[i];
     const auto start = std::chrono::steady_clock::now();
     try {
-      const TriMesh turned = rotated(mesh, c.rotation);
-      auto t = std::make_shared<TopologyResult>(analyse_topology(turned, topology));
-      auto p = std::make_shared<PolycubeResult>(build_polycube(turned, *t, scoring));
-      c.corners = static_cast<int>(p->polycube.corners.size());
-      const std::lock_guard<std::mutex> guard(lock);
-      const bool better = out.chosen < 0 || c.corners < out.candidates[out.chosen].corners ||
-                          (c.corners == out.candidates[out.chosen].corners && i < out.chosen);
-      if (better) {
-        out.chosen = i;
-        out.topology = std::move(t);
-        out.polycube = std::move(p);
-      }
+      turned[i] = rotated(mesh, c.rotation);
+      topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
+      polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], scoring));
+      c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
     } catch (const Error& e) {
       c.error = e.what();
+      topologies[i].reset();
+      polycubes[i].reset();
     }
     c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   });
+  // The few with the fewest corners get their map built and audited (vertex-sampled flips both
+  // ways, ε_angle): corners alone do not tell a good map from a bad one.
+  std::vector<int> mapped;
+  for (int i = 0; i < n; ++i)
+    if (polycubes[i]) mapped.push_back(i);
+  std::stable_sort(mapped.begin(), mapped.end(), [&](int a, int b) { return out.candidates[a].corners < out.candidates[b].corners; });
+  if (static_cast<int>(mapped.size()) > options.mapped_candidates) mapped.resize(std::max(1, options.mapped_candidates));
+  std::vector<std::shared_ptr<PolycubeMap>> maps(n);
+  if (options.mapped_candidates > 0) {
+    parallel_for_each(mapped, options.threads, "orientation", [&](int i) {
+      AlignmentCandidate& c = out.candidates[i];
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        maps[i] = std::make_shared<PolycubeMap>(build_polycube_map(turned[i], *polycubes[i]));
+        const MapAudit audit = audit_map(turned[i], polycubes[i]->polycube.mesh, maps[i]->polycube_on_model_xyz, maps[i]->model_on_polycube_xyz);
+        c.flipped = audit.polycube_to_model.flipped + audit.model_to_polycube.flipped + audit.polycube_to_model.degenerate +
+                    audit.model_to_polycube.degenerate;
+        c.eps_angle = audit.distortion.eps_angle;
+      } catch (const Error& e) {
+        c.error = e.what();
+        maps[i].reset();
+      }
+      c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    });
+  }
+  // Fewest flips, then least ε_angle, then fewest corners, then the earlier candidate.
+  auto key = [&](int i) {
+    const AlignmentCandidate& c = out.candidates[i];
+    return std::make_tuple(maps[i] ? 0 : 1, maps[i] ? c.flipped : 0, maps[i] ? c.eps_angle : 0.0, c.corners, i);
+  };
+  for (int i = 0; i < n; ++i) {
+    if (!polycubes[i]) continue;
+    if (out.chosen < 0 || key(i) < key(out.chosen)) out.chosen = i;
+  }
+  if (out.chosen >= 0) {
+    out.topology = topologies[out.chosen];
+    out.polycube = polycubes[out.chosen];
+    out.map = maps[out.chosen];
+  }
   if (out.chosen >= 0) out.rotation = out.candidates[out.chosen].rotation;
   return out;
 }

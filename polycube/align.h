@@ -1,11 +1,13 @@
 // Auto-orientation (the paper's limitation 1: its polycube depends on how the model is turned).
 // Candidates are the input frame and the model's principal axes, each with each of its three axes
-// as the sweep direction z; each is scored by building the polycube, and the one with the fewest
-// corners wins.
+// as the sweep direction z. Each gets its polycube (under a small repair budget); the few with the
+// fewest corners also get their map, and the map with the fewest flipped image triangles (then the
+// least ε_angle, then the fewest corners) wins.
 #pragma once
 
 #include "polycube/mesh.h"
 #include "polycube/polycube_build.h"
+#include "polycube/polycube_map.h"
 #include "polycube/topology.h"
 
 #include <Eigen/Core>
@@ -18,22 +20,27 @@ namespace polycube {
 
 // One orientation tried: x_aligned = rotation * x_input (a proper rotation).
 //   corners  of the polycube built in it (-1 if the stages failed there, see error)
+//   flipped, eps_angle  of its map before smoothing, both directions (-1 if not mapped)
 struct AlignmentCandidate {
   std::string name;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   int corners = -1;
+  int flipped = -1;
+  double eps_angle = -1;
   double seconds = 0;
   std::string error;
 };
 
 //   chosen     index of the winner, -1 if every candidate failed within the scoring budget
-//   topology, polycube  the winner's stages (built on the turned model), so they need not be redone
+//   topology, polycube, map  the winner's stages (built on the turned model), so they need not be
+//              redone (map is null when the winner was not mapped)
 struct Alignment {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   int chosen = -1;
   std::vector<AlignmentCandidate> candidates;
   std::shared_ptr<TopologyResult> topology;
   std::shared_ptr<PolycubeResult> polycube;
+  std::shared_ptr<PolycubeMap> map;
 };
 
 // Principal axes of the surface (area-weighted covariance of the triangles), as the rows of a
@@ -52,11 +59,11 @@ struct AlignmentOptions {
   int max_inserted_planes = 30;
   int max_plane_cells = 4000;
   int max_repair_level = 12;
+  // How many candidates (fewest corners first) get their map built and audited; 0: corners only.
+  int mapped_candidates = 3;
 };
 
-// Scores the six candidates (input frame / principal axes × which axis is z) by the corner count
-// of the polycube built with the options (capped by the budget), fewest first; ties keep the
-// earlier candidate (the input frame first).
+// Scores the six candidates (input frame / principal axes × which axis is z); see the top.
 Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology, const PolycubeOptions& polycube,
                            const AlignmentOptions& options = {});
 
