@@ -106,10 +106,9 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   for (int i = 0; i < n; ++i)
     if (polycubes[i]) mapped.push_back(i);
   std::stable_sort(mapped.begin(), mapped.end(), [&](int a, int b) { return out.candidates[a].corners < out.candidates[b].corners; });
-  if (static_cast<int>(mapped.size()) > options.mapped_candidates) mapped.resize(std::max(1, options.mapped_candidates));
   std::vector<std::shared_ptr<PolycubeMap>> maps(n);
-  if (options.mapped_candidates > 0) {
-    parallel_for_each(mapped, options.threads, "orientation", [&](int i) {
+  auto map_candidates = [&](const std::vector<int>& which) {
+    parallel_for_each(which, options.threads, "orientation", [&](int i) {
       AlignmentCandidate& c = out.candidates[i];
       const auto start = std::chrono::steady_clock::now();
       try {
@@ -124,6 +123,14 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       }
       c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     });
+  };
+  if (options.mapped_candidates > 0) {
+    const size_t first = std::min(mapped.size(), static_cast<size_t>(options.mapped_candidates));
+    map_candidates(std::vector<int>(mapped.begin(), mapped.begin() + first));
+    // Still flips in every map tried: the others get their map too.
+    bool clean = false;
+    for (size_t k = 0; k < first; ++k) clean = clean || (maps[mapped[k]] && out.candidates[mapped[k]].flipped == 0);
+    if (!clean && first < mapped.size()) map_candidates(std::vector<int>(mapped.begin() + first, mapped.end()));
   }
   // Fewest flips, then least ε_angle, then fewest corners, then the earlier candidate.
   auto key = [&](int i) {

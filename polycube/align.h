@@ -59,7 +59,8 @@ struct AlignmentOptions {
   int max_inserted_planes = 30;
   int max_plane_cells = 4000;
   int max_repair_level = 12;
-  // How many candidates (fewest corners first) get their map built and audited; 0: corners only.
+  // How many candidates (fewest corners first) get their map built and audited first; if all of
+  // those still have flipped triangles, the rest are mapped too. 0: corners only.
   int mapped_candidates = 3;
 };
 

@@ -9,6 +9,9 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <vector>
+
 namespace polycube {
 namespace {
 
@@ -42,21 +45,34 @@ TEST(Align, AlignedModelsAreNotTilted) {
   EXPECT_GT((principal_axes(rotated(box(Eigen::Vector3d::Zero()), large)).cwiseAbs() - Eigen::Matrix3d::Identity()).norm(), 0.1);
 }
 
-TEST(Align, ChoosesTheCandidateWithFewestCorners) {
+// The winner is the mapped candidate with the fewest flipped triangles (then least ε_angle); the
+// three with the fewest corners are always mapped; the winner's stages come with it.
+TEST(Align, ChoosesTheMappedCandidateWithFewestFlips) {
   const TriMesh model = load_test_mesh("knot.off");
   const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{});
   ASSERT_EQ(a.candidates.size(), 6u);
   ASSERT_GE(a.chosen, 0);
+  const AlignmentCandidate& w = a.candidates[a.chosen];
+  ASSERT_GE(w.flipped, 0) << "the winner was mapped";
+  std::vector<int> corners;
   for (const AlignmentCandidate& c : a.candidates) {
     EXPECT_NEAR(c.rotation.determinant(), 1.0, 1e-9) << c.name;
-    if (c.corners >= 0) {
-      EXPECT_GE(c.corners, a.candidates[a.chosen].corners) << c.name;
+    if (c.corners >= 0) corners.push_back(c.corners);
+    if (c.flipped >= 0) {
+      EXPECT_TRUE(c.flipped > w.flipped || (c.flipped == w.flipped && c.eps_angle >= w.eps_angle)) << c.name;
     }
   }
+  std::sort(corners.begin(), corners.end());
+  int mapped_with_few_corners = 0;
+  for (const AlignmentCandidate& c : a.candidates)
+    if (c.corners >= 0 && c.corners <= corners[std::min<size_t>(2, corners.size() - 1)] && c.flipped >= 0) ++mapped_with_few_corners;
+  EXPECT_GE(mapped_with_few_corners, std::min<int>(3, static_cast<int>(corners.size())));
   ASSERT_TRUE(a.polycube);
-  EXPECT_EQ(static_cast<int>(a.polycube->polycube.corners.size()), a.candidates[a.chosen].corners);
+  ASSERT_TRUE(a.map);
+  EXPECT_EQ(static_cast<int>(a.polycube->polycube.corners.size()), w.corners);
   EXPECT_EQ(a.polycube->genus, 1);
-  EXPECT_EQ(a.rotation, a.candidates[a.chosen].rotation);
+  EXPECT_EQ(a.map->polycube_on_model_xyz.rows(), a.polycube->polycube.mesh.num_vertices());
+  EXPECT_EQ(a.rotation, w.rotation);
 }
 
 }  // namespace
