@@ -11,6 +11,7 @@
 #include "polycube/errors.h"
 #include "polycube/polycube_build.h"
 #include "polycube/map_audit.h"
+#include "polycube/map_quality.h"
 #include "polycube/map_smoothing.h"
 #include "polycube/polycube_map.h"
 #include "polycube/topology.h"
@@ -241,9 +242,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     on_polycube_xyz = map->model_on_polycube_xyz;
     nlohmann::json smoothing = nullptr;
     if (options.smooth_sweeps > 0) {
-      const MapAudit before = audit_map(model, polycube->polycube.mesh, on_model_xyz, on_polycube_xyz);
-      progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded (" + std::to_string(before.polycube_to_model.flipped) +
-                                   " / " + std::to_string(before.model_to_polycube.flipped) + " flipped before)");
+      progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded");
+      // smooth_map audits its input itself (flipped_before); the distortion before is cheap.
+      const DistortionStats before = map_distortion(polycube->polycube.mesh, on_model_xyz);
       MapSmoothingOptions smooth_options;
       smooth_options.sweeps = options.smooth_sweeps;
       const MapSmoothingResult smoothed = smooth_map(model, polycube->polycube, *map, smooth_options);
@@ -257,12 +258,14 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                    {"frozen_polycube_vertices", smoothed.frozen},
                    {"relocated_model_vertices", smoothed.relocated},
                    {"seconds", smoothed.seconds},
-                   {"before", {{"polycube_to_model", direction_json(before.polycube_to_model)},
-                               {"model_to_polycube", direction_json(before.model_to_polycube)},
-                               {"eps_angle", before.distortion.eps_angle},
-                               {"eps_area", before.distortion.eps_area},
-                               {"angle_p95", before.distortion.angle_p95},
-                               {"angle_max", before.distortion.angle_max}}}};
+                   {"before", {{"polycube_to_model_flipped", smoothed.flipped_before[0]},
+                               {"model_to_polycube_flipped", smoothed.flipped_before[1]},
+                               {"eps_angle", before.eps_angle},
+                               {"eps_area", before.eps_area},
+                               {"angle_p95", before.angle_p95},
+                               {"angle_max", before.angle_max}}}};
+      progress.stage("smooth", std::to_string(smoothed.flipped_before[0]) + " / " + std::to_string(smoothed.flipped_before[1]) + " flipped before, " +
+                                   std::to_string(smoothed.flipped_after[0]) + " / " + std::to_string(smoothed.flipped_after[1]) + " after");
     }
     const MapAudit audit = audit_map(model, polycube->polycube.mesh, on_model_xyz, on_polycube_xyz);
     report["map"] = {{"contours", map->contours},

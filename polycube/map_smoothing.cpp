@@ -725,54 +725,52 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
       if (!moved[PM.F(T0, 0)] && !moved[PM.F(T0, 1)] && !moved[PM.F(T0, 2)]) continue;
       changed[w] = 1;
       bool found = false;
-      // First the walk with the chords' normal-prism coordinates (consistent across P's edges).
-      {
-        const Vec3 x = row(M.mesh().V, w);
+      // Walks over P's triangles from T0 towards w: `coordinates(T, bary)` gives w's barycentrics
+      // in T (false where they cannot be had); stops in the triangle where all are >= 0.
+      auto walk = [&](int steps, auto&& coordinates) {
         int T = T0;
-        for (int step = 0; step < 200; ++step) {
-          Vec3 yy[3], nn[3], bary;
-          for (int i = 0; i < 3; ++i) {
-            yy[i] = Y[PM.F(T, i)];
-            nn[i] = N[PM.F(T, i)];
-          }
-          if ((yy[1] - yy[0]).cross(yy[2] - yy[0]).dot(nn[0] + nn[1] + nn[2]) <= 0 || !normal_prism_coordinates(yy, nn, x, bary)) break;
+        for (int step = 0; step < steps; ++step) {
+          Vec3 bary;
+          if (!coordinates(T, bary)) return false;
           int lowest = 0;
           for (int i = 1; i < 3; ++i)
             if (bary[i] < bary[lowest]) lowest = i;
           if (bary[lowest] >= -1e-12) {
             out[w].face = T;
             out[w].bary = normalized_bary(bary);
-            found = true;
-            break;
+            return true;
           }
           T = P.across()(T, lowest);
         }
-      }
+        return false;
+      };
+      // First the walk with the chords' normal-prism coordinates (consistent across P's edges).
+      const Vec3 x = row(M.mesh().V, w);
+      found = walk(200, [&](int T, Vec3& bary) {
+        Vec3 yy[3], nn[3];
+        for (int i = 0; i < 3; ++i) {
+          yy[i] = Y[PM.F(T, i)];
+          nn[i] = N[PM.F(T, i)];
+        }
+        return (yy[1] - yy[0]).cross(yy[2] - yy[0]).dot(nn[0] + nn[1] + nn[2]) > 0 && normal_prism_coordinates(yy, nn, x, bary);
+      });
       for (int depth : {4, 8, 16, 40}) {
         if (found) break;
         chart.build(w, depth);
         const Vec2 target = chart.position(w);
-        Vec2 a, b, c;
-        int T = T0;
-        for (int step = 0; step < 1000 && corners(T, a, b, c); ++step) {
-          const Vec3 bary = barycentric2(a, b, c, target);
-          int lowest = 0;
-          for (int i = 1; i < 3; ++i)
-            if (bary[i] < bary[lowest]) lowest = i;
-          if (bary[lowest] >= -1e-12) {
-            out[w].face = T;
-            out[w].bary = normalized_bary(bary);
-            found = true;
-            break;
-          }
-          T = P.across()(T, lowest);
-        }
+        found = walk(1000, [&](int T, Vec3& bary) {
+          Vec2 a, b, c;
+          if (!corners(T, a, b, c)) return false;
+          bary = barycentric2(a, b, c, target);
+          return true;
+        });
         if (found) break;
         // The walk left the chart or met an inverted triangle: every P triangle with a corner
         // imaged in the chart.
         int best = -1;
         double best_min = -INFINITY;
         Vec3 best_bary = Vec3::Zero();
+        Vec2 a, b, c;
         ++search;
         for (int f : chart.triangles())
           for (const int* v = images_in.first(f); v != images_in.last(f); ++v)

@@ -96,12 +96,7 @@ TEST_P(MapSmoothingOnMeshes, NoNewFlipsImagesOnSurfacesLowerAngleDistortion) {
 INSTANTIATE_TEST_SUITE_P(Meshes, MapSmoothingOnMeshes,
                          ::testing::Values("sphere.off", "eight.off", "knot.off", "helmet.off", "double-torus-example.off", "rocker-arm.obj",
                                            "generated-genus-5"),
-                         [](const auto& info) {
-                           std::string s = info.param.substr(0, info.param.find('.'));
-                           for (char& ch : s)
-                             if (ch == '-') ch = '_';
-                           return s;
-                         });
+                         [](const auto& info) { return test::test_name_of_file(info.param); });
 
 // Every closed mesh of tests/data, the coarse and tangled ones included (where the guard may keep
 // much of the input): no direction gets worse, images stay on the surfaces, the angle distortion

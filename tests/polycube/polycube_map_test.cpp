@@ -118,12 +118,7 @@ TEST_P(PolycubeMapOnMeshes, DisksEmbedImagesOnSurfacesRoundTrip) {
 
 INSTANTIATE_TEST_SUITE_P(Meshes, PolycubeMapOnMeshes,
                          ::testing::Values("sphere.off", "eight.off", "knot.off", "helmet.off", "double-torus-example.off", "rocker-arm.obj"),
-                         [](const auto& info) {
-                           std::string s = info.param.substr(0, info.param.find('.'));
-                           for (char& ch : s)
-                             if (ch == '-') ch = '_';
-                           return s;
-                         });
+                         [](const auto& info) { return test::test_name_of_file(info.param); });
 
 // Surfaces no one tuned for: generated genus 5 and 11. Every disk embeds, φ⁻¹ ∘ φ is the identity
 // and the images lie on the surfaces.

@@ -28,6 +28,13 @@ const std::map<std::string, int>& closed_test_meshes() {
 
 TriMesh load_test_mesh(const std::string& name) { return load_mesh_file(data_path(name)); }
 
+std::string test_name_of_file(const std::string& file) {
+  std::string name = file.substr(0, file.find('.'));
+  for (char& c : name)
+    if (c == '-') c = '_';
+  return name;
+}
+
 TriMesh load_mesh_file(const std::string& path) {
   PrepareOptions options;
   options.check_self_intersections = false;

@@ -20,6 +20,10 @@ const std::map<std::string, int>& closed_test_meshes();
 // self-intersection search. Throws MeshError if it is not mappable.
 TriMesh load_test_mesh(const std::string& name);
 
+// A GoogleTest parameter name for a mesh file name: "double-torus-example.off" ->
+// "double_torus_example".
+std::string test_name_of_file(const std::string& file);
+
 // Any mesh file read and prepared like load_test_mesh.
 TriMesh load_mesh_file(const std::string& path);
 
