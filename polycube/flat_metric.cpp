@@ -434,7 +434,7 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
   const long long max_flips = static_cast<long long>(options.max_flips_per_edge * std::max(1, num_edges));
   Eigen::VectorXd u = Eigen::VectorXd::Zero(nv);
   if (options.initial_delaunay)
-    result.initial_flips = static_cast<int>(ricci::make_delaunay(m, u, true, options.delaunay_tolerance, max_flips));
+    result.initial_flips = static_cast<int>(ricci::make_delaunay(m, u, {true, options.delaunay_tolerance, max_flips}));
   const int max_inserted = options.max_inserted_vertices >= 0 ? options.max_inserted_vertices : boundary_halfedges + 16;
 
   // Splits the boundary edge of halfedge h at its midpoint in the metric at u and records it.
@@ -478,7 +478,7 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
         if (static_cast<int>(result.inserted_vertices.size()) < max_inserted && split_boundary_edge(h)) any = true;
       if (!any) break;
       if (options.initial_delaunay)
-        result.initial_flips += static_cast<int>(ricci::make_delaunay(m, u, true, options.delaunay_tolerance, max_flips));
+        result.initial_flips += static_cast<int>(ricci::make_delaunay(m, u, {true, options.delaunay_tolerance, max_flips}));
     }
   }
   result.presplit_vertices = static_cast<int>(result.inserted_vertices.size());
@@ -606,7 +606,7 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
       std::vector<int> too_long;
       for (int step = 0; step <= options.max_line_search_steps; ++step) {
         u_trial = u + t * delta_full;
-        if (options.delaunay_flips) ricci::make_delaunay(m, u_trial, false, options.delaunay_tolerance, max_flips);
+        if (options.delaunay_flips) ricci::make_delaunay(m, u_trial, {false, options.delaunay_tolerance, max_flips});
         evaluate(m, u_trial, loops, outer, trial);
         const bool more_invalid = trial.invalid_triangles > ev.invalid_triangles;
         // The balance may not grow beyond max(current, balance_slack): far from the solution
@@ -637,7 +637,7 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
         ++result.iterations;
       } else {
         // Leave the triangulation Delaunay for the last accepted u.
-        if (options.delaunay_flips) ricci::make_delaunay(m, u, false, options.delaunay_tolerance, max_flips);
+        if (options.delaunay_flips) ricci::make_delaunay(m, u, {false, options.delaunay_tolerance, max_flips});
         evaluate(m, u, loops, outer, ev);
       }
       const std::string stalled =
@@ -659,7 +659,7 @@ FlatMetric flat_metric(const TriMesh& piece, const std::vector<std::vector<int>>
       if (static_cast<int>(result.inserted_vertices.size()) < max_inserted && split_boundary_edge(h)) any = true;
     if (any) {
       failure.clear();
-      if (options.delaunay_flips) ricci::make_delaunay(m, u, false, options.delaunay_tolerance, max_flips);
+      if (options.delaunay_flips) ricci::make_delaunay(m, u, {false, options.delaunay_tolerance, max_flips});
       reindex();
       evaluate(m, u, loops, outer, ev);
     } else if (!failure.empty()) {

@@ -172,7 +172,7 @@ bool cyclic_polygon(const std::vector<double>& x, double& rho, std::vector<doubl
   return true;
 }
 
-RicciMesh build_ricci_mesh(const TriMesh& mesh, double log_scale) {
+RicciMesh build_ricci_mesh(const TriMesh& mesh, double log_scale, const char* caller) {
   const int nf = mesh.num_faces();
   const int nv = mesh.num_vertices();
   RicciMesh r;
@@ -191,13 +191,13 @@ RicciMesh build_ricci_mesh(const TriMesh& mesh, double log_scale) {
       const int h = 3 * f + i;
       const int a = mesh.F(f, i), b = mesh.F(f, (i + 1) % 3);
       if (a == b || a < 0 || b < 0 || a >= nv || b >= nv)
-        throw MeshError("flat_metric: face " + std::to_string(f) + " has bad or repeated vertex ids");
+        throw MeshError(std::string(caller) + ": face " + std::to_string(f) + " has bad or repeated vertex ids");
       r.next[h] = 3 * f + (i + 1) % 3;
       r.vert[h] = a;
       r.face[h] = f;
       const double len = (mesh.V.row(a) - mesh.V.row(b)).norm();
       if (!(len > 0) || !std::isfinite(len))
-        throw MeshError("flat_metric: edge (" + std::to_string(a) + ", " + std::to_string(b) + ") has length " +
+        throw MeshError(std::string(caller) + ": edge (" + std::to_string(a) + ", " + std::to_string(b) + ") has length " +
                         std::to_string(len));
       r.lambda[h] = std::log(len) - log_scale;
       keys.emplace_back(static_cast<long long>(a) * nv + b, h);
@@ -206,7 +206,7 @@ RicciMesh build_ricci_mesh(const TriMesh& mesh, double log_scale) {
   std::sort(keys.begin(), keys.end());
   for (size_t k = 1; k < keys.size(); ++k)
     if (keys[k].first == keys[k - 1].first)
-      throw MeshError("flat_metric: faces " + std::to_string(keys[k - 1].second / 3) + " and " +
+      throw MeshError(std::string(caller) + ": faces " + std::to_string(keys[k - 1].second / 3) + " and " +
                       std::to_string(keys[k].second / 3) +
                       " traverse an edge in the same direction (non-manifold or inconsistently oriented)");
   for (const auto& [key, h] : keys) {
@@ -279,8 +279,7 @@ double euclidean_diagonal(double jk, double ki, double il, double lj) {
 
 }  // namespace
 
-long long make_delaunay(RicciMesh& m, const Eigen::VectorXd& u, bool euclidean, double tolerance,
-                        long long max_flips) {
+long long make_delaunay(RicciMesh& m, const Eigen::VectorXd& u, const FlipRules& rules) {
   const int nh = m.num_halfedges();
   std::vector<int> stack;
   std::vector<char> queued(nh, 0);
@@ -290,20 +289,27 @@ long long make_delaunay(RicciMesh& m, const Eigen::VectorXd& u, bool euclidean, 
       stack.push_back(h);
       queued[h] = 1;
     }
+  std::vector<int> degree;
+  if (rules.keep_links_simple) {
+    degree.assign(m.num_vertices, 0);
+    for (int h = 0; h < nh; ++h) ++degree[m.vert[h]];
+  }
   long long flips = 0;
-  while (!stack.empty() && flips < max_flips) {
+  while (!stack.empty() && flips < rules.max_flips) {
     const int h = stack.back();
     stack.pop_back();
     queued[h] = 0;
     const int t = m.twin[h];
     if (m.face[h] == m.face[t]) continue;
-    if (cos_sum(m, h, u) >= -tolerance) continue;
+    if (cos_sum(m, h, u) >= -rules.tolerance) continue;
     const int h1 = m.next[h], h2 = m.next[h1], t1 = m.next[t], t2 = m.next[t1];
+    const int i = m.vert[h], j = m.vert[t], k = m.vert[h2], l = m.vert[t2];
+    if (rules.keep_links_simple && (k == l || degree[i] <= 3 || degree[j] <= 3)) continue;
     const double xa = m.log_length(h, u);
     const double jk = m.log_length(h1, u) - xa, ki = m.log_length(h2, u) - xa;
     const double il = m.log_length(t1, u) - xa, lj = m.log_length(t2, u) - xa;
     double x_new;  // log-length of the new edge at u
-    if (euclidean) {
+    if (rules.euclidean) {
       const double d = euclidean_diagonal(std::exp(jk), std::exp(ki), std::exp(il), std::exp(lj));
       if (!(d > 0) || !std::isfinite(d)) continue;
       x_new = xa + std::log(d);
@@ -312,9 +318,14 @@ long long make_delaunay(RicciMesh& m, const Eigen::VectorXd& u, bool euclidean, 
       const double p = ki + lj, q = il + jk;
       x_new = xa + std::max(p, q) + std::log1p(std::exp(-std::abs(p - q)));
     }
-    const int k = m.vert[h2], l = m.vert[t2];
     flip(m, h, x_new - 0.5 * (u[k] + u[l]));
     ++flips;
+    if (rules.keep_links_simple) {
+      --degree[i];
+      --degree[j];
+      ++degree[k];
+      ++degree[l];
+    }
     for (int g : {h1, h2, t1, t2}) {
       const int tg = m.twin[g];
       if (tg < 0) continue;
@@ -326,6 +337,17 @@ long long make_delaunay(RicciMesh& m, const Eigen::VectorXd& u, bool euclidean, 
     }
   }
   return flips;
+}
+
+double cotan_sum(const RicciMesh& m, int h, const Eigen::VectorXd& u) {
+  double sum = 0;
+  for (int g : {h, m.twin[h]}) {
+    const double x[3] = {m.log_length(g, u), m.log_length(m.next[g], u), m.log_length(m.next[m.next[g]], u)};
+    double angle[3], cot[3];
+    triangle_angles(x, angle, cot);
+    sum += cot[0];
+  }
+  return sum;
 }
 
 namespace {

@@ -1,4 +1,4 @@
-// Internal to flat_metric / circle_domain: a triangulated surface with boundary as a Δ-complex
+// Internal to flat_metric / circle_domain / intrinsic_delaunay: a triangulated surface with boundary as a Δ-complex
 // (halfedges with explicit next pointers, so intrinsic flips can join two vertices by several
 // edges), carrying a discrete conformal metric in the form of Gillespie–Springborn–Crane,
 // "Discrete conformal equivalence of polyhedral surfaces" (2021): every edge e = ij stores a base
@@ -60,19 +60,33 @@ struct RicciMesh {
 
 // Halfedges of an oriented, edge-manifold triangle mesh with boundary; lambda = log of the
 // Euclidean edge lengths minus log_scale (so the lengths are in units of exp(log_scale)).
-// Throws MeshError for an edge with more than two faces, two faces traversing an edge in the
-// same direction, a face repeating a vertex, or an edge of zero or non-finite length.
-RicciMesh build_ricci_mesh(const TriMesh& mesh, double log_scale);
+// Throws MeshError (its message starting with `caller`) for an edge with more than two faces, two
+// faces traversing an edge in the same direction, a face repeating a vertex, or an edge of zero or
+// non-finite length.
+RicciMesh build_ricci_mesh(const TriMesh& mesh, double log_scale, const char* caller = "flat_metric");
+
+// How make_delaunay flips.
+//   euclidean          the new edge gets the length of the other diagonal of the two triangles
+//                      laid out in the plane (the metric is kept: intrinsic Delaunay
+//                      triangulation); otherwise Ptolemy's relation l_kl = (l_ik l_jl + l_il l_jk)
+//                      / l_ij (the conformal class is kept)
+//   tolerance          an edge is Delaunay when cos(alpha) + cos(beta) >= -tolerance
+//   max_flips          stop after this many flips (then some edges may stay non-Delaunay)
+//   keep_links_simple  never flip to an edge from a vertex to itself, nor leave a vertex with
+//                      fewer than three edges (PL Morse theory needs every vertex link to be a
+//                      cycle of at least three other vertices); for closed meshes
+struct FlipRules {
+  bool euclidean = true;
+  double tolerance = 0;
+  long long max_flips = 0;
+  bool keep_links_simple = false;
+};
 
 // Flips interior edges until every one is Delaunay at the scale factors u:
 // cos(alpha) + cos(beta) >= -tolerance for the angles alpha, beta opposite it (meaningful for
-// lengths violating the triangle inequality, too). euclidean: the new edge gets the length of the
-// other diagonal of the two triangles laid out in the plane (the metric is kept: intrinsic
-// Delaunay triangulation); otherwise Ptolemy's relation l_kl = (l_ik l_jl + l_il l_jk) / l_ij
-// (the conformal class is kept). Edges whose two sides are the same face are never flipped.
-// Returns the number of flips; stops after max_flips (then some edges may stay non-Delaunay).
-long long make_delaunay(RicciMesh& mesh, const Eigen::VectorXd& u, bool euclidean, double tolerance,
-                        long long max_flips);
+// lengths violating the triangle inequality, too). Edges whose two sides are the same face are
+// never flipped. Returns the number of flips.
+long long make_delaunay(RicciMesh& mesh, const Eigen::VectorXd& u, const FlipRules& rules);
 
 // Splits the edge of h at its midpoint in the metric at u: a new vertex m (id num_vertices - 1
 // afterwards, u extended by u_m = (u_a + u_b) / 2) joined to the vertex opposite the edge in each
@@ -84,5 +98,9 @@ int split_edge(RicciMesh& mesh, int h, Eigen::VectorXd& u);
 
 // Number of interior edges with cos(alpha) + cos(beta) < -tolerance at u.
 int count_non_delaunay(const RicciMesh& mesh, const Eigen::VectorXd& u, double tolerance);
+
+// cot(alpha) + cot(beta) of the interior edge of h at u (alpha, beta opposite it; a degenerate
+// triangle contributes 0): the edge's cotangent Laplacian weight, times 2.
+double cotan_sum(const RicciMesh& mesh, int h, const Eigen::VectorXd& u);
 
 }  // namespace polycube::ricci
