@@ -12,6 +12,7 @@
 #include "polycube/polycube_build.h"
 #include "polycube/map_audit.h"
 #include "polycube/map_quality.h"
+#include "polycube/map_refinement.h"
 #include "polycube/map_smoothing.h"
 #include "polycube/polycube_map.h"
 #include "polycube/topology.h"
@@ -22,6 +23,7 @@
 #include <iomanip>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 namespace polycube::cli {
 
@@ -41,6 +43,7 @@ struct MapOptions {
   std::string stage = kStages.back();
   std::string align = "auto";
   int smooth_sweeps = 10;
+  bool refine = true;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -110,6 +113,18 @@ void write_map_preview(const std::string& path, const TriMesh& model, const Poly
   options.same_scale = true;
   write_image(path, render_tiles({m, p}, options));
 }
+
+// The end of the map stage on one P: the smoothing, the second refinement, the audit.
+struct Finished {
+  const Polycube* polycube = nullptr;
+  std::unique_ptr<MapRefinementResult> resampling;
+  Eigen::MatrixX3d on_model_xyz, on_polycube_xyz;
+  nlohmann::json smoothing = nullptr, resampling_report = nullptr;
+  double smooth_seconds = 0, resample_seconds = 0;
+  MapAudit audit;
+  int bad_p() const { return audit.polycube_to_model.flipped + audit.polycube_to_model.degenerate; }
+  int bad_m() const { return audit.model_to_polycube.flipped + audit.model_to_polycube.degenerate; }
+};
 
 nlohmann::json polycube_json(const PolycubeResult& result) {
   const Polycube& p = result.polycube;
@@ -203,6 +218,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   const SlicedMesh* model_pieces = &topology.sliced;
   std::optional<PolycubeResult> polycube;
   std::optional<PolycubeMap> map;
+  std::optional<MapRefinementResult> refinement;  // P's sampling refined before the smoothing
+  std::unique_ptr<Finished> finished;              // after it: the P and sampling written
+  const Polycube* written_polycube = nullptr;  // P as written: refined when the map refines its sampling
   Eigen::MatrixX3d on_model_xyz, on_polycube_xyz;  // the map at the vertices, smoothed when asked
   if (runs(options.stage, "polycube")) {
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
@@ -214,7 +232,10 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     progress.stage("polycube", std::to_string(polycube->polycube.corners.size()) + " corners, " +
                                    std::to_string(polycube->polycube.faces.size()) + " faces, " +
                                    std::to_string(polycube->polycube_sliced.pieces.size()) + " pieces matched");
-    const std::string polycube_path = (dir / "polycube.obj").string();
+    written_polycube = &polycube->polycube;
+  }
+  const std::string polycube_path = (dir / "polycube.obj").string();
+  if (polycube && !runs(options.stage, "map")) {
     write_mesh(polycube_path, mesh_to_input(polycube->polycube.mesh));
     outputs.push_back(polycube_path);
   }
@@ -237,37 +258,137 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       return nlohmann::json{{"triangles", a.triangles}, {"flipped", a.flipped}, {"degenerate", a.degenerate},
                             {"max_distance", a.max_distance}, {"area_ratio", a.area_ratio}, {"ok", a.ok}};
     };
-    // Stage 5 (§3.5): smoothing that never adds a flip in either direction.
-    on_model_xyz = map->polycube_on_model_xyz;
-    on_polycube_xyz = map->model_on_polycube_xyz;
-    nlohmann::json smoothing = nullptr;
-    if (options.smooth_sweeps > 0) {
-      progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded");
-      // smooth_map audits its input itself (flipped_before); the distortion before is cheap.
-      const DistortionStats before = map_distortion(polycube->polycube.mesh, on_model_xyz);
-      MapSmoothingOptions smooth_options;
-      smooth_options.sweeps = options.smooth_sweeps;
-      const MapSmoothingResult smoothed = smooth_map(model, polycube->polycube, *map, smooth_options);
-      on_model_xyz = smoothed.polycube_on_model_xyz;
-      on_polycube_xyz = smoothed.model_on_polycube_xyz;
-      seconds["smooth"] = smoothed.seconds;
-      smoothing = {{"sweeps", smoothed.sweeps},
-                   {"rounds", smoothed.rounds},
-                   {"moves", smoothed.moves},
-                   {"rejected", smoothed.rejected},
-                   {"frozen_polycube_vertices", smoothed.frozen},
-                   {"relocated_model_vertices", smoothed.relocated},
-                   {"seconds", smoothed.seconds},
-                   {"before", {{"polycube_to_model_flipped", smoothed.flipped_before[0]},
-                               {"model_to_polycube_flipped", smoothed.flipped_before[1]},
-                               {"eps_angle", before.eps_angle},
-                               {"eps_area", before.eps_area},
-                               {"angle_p95", before.angle_p95},
-                               {"angle_max", before.angle_max}}}};
-      progress.stage("smooth", std::to_string(smoothed.flipped_before[0]) + " / " + std::to_string(smoothed.flipped_before[1]) + " flipped before, " +
-                                   std::to_string(smoothed.flipped_after[0]) + " / " + std::to_string(smoothed.flipped_after[1]) + " after");
+    // P's sampling of φ refined where its chords flip or lose area (issue 5), before the smoothing
+    // (φ itself at the new vertices) and after it (the smoothed chords projected on the model):
+    // P's surface stays the same, its triangulation gets finer, and every later step and file
+    // uses the refined one.
+    auto refinement_json = [](const MapRefinementResult& r) {
+      auto side = [](const MapDirectionAudit& a) {
+        return nlohmann::json{{"flipped", a.flipped}, {"degenerate", a.degenerate}, {"area_ratio", a.area_ratio}};
+      };
+      return nlohmann::json{{"refined", r.refined},       {"converged", r.converged},
+                            {"rounds", r.rounds},         {"bisections", r.bisections},
+                            {"vertices_before", r.vertices_before}, {"vertices_after", r.vertices_after},
+                            {"triangles_before", r.triangles_before}, {"triangles_after", r.triangles_after},
+                            {"before", side(r.before)},   {"after", side(r.after)},
+                            {"model_to_polycube_before", side(r.model_to_polycube_before)},
+                            {"model_to_polycube_after", side(r.model_to_polycube_after)},
+                            {"model_to_polycube_rejected", r.model_to_polycube_rejected},
+                            {"frozen_faces", r.frozen_faces},
+                            {"seconds", r.seconds}};
+    };
+    auto refinement_line = [](const MapRefinementResult& r) {
+      std::ostringstream line;
+      line << r.vertices_before << " -> " << r.vertices_after << " vertices in " << r.rounds << " rounds; P to M flipped "
+           << r.before.flipped + r.before.degenerate << " -> " << r.after.flipped + r.after.degenerate << ", image area "
+           << std::fixed << std::setprecision(4) << r.before.area_ratio << " -> " << r.after.area_ratio;
+      return line.str();
+    };
+    // Stage 5 (§3.5): smoothing that never adds a flip in either direction, then the second
+    // refinement, on a given P and sampling; the audit of the result.
+    auto finish = [&](const Polycube& P, const PolycubeMap& sampled) {
+      auto out = std::make_unique<Finished>();
+      out->polycube = &P;
+      out->on_model_xyz = sampled.polycube_on_model_xyz;
+      out->on_polycube_xyz = sampled.model_on_polycube_xyz;
+      if (options.smooth_sweeps > 0) {
+        progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded");
+        // smooth_map audits its input itself (flipped_before); the distortion before is cheap.
+        const DistortionStats before = map_distortion(P.mesh, out->on_model_xyz);
+        MapSmoothingOptions smooth_options;
+        smooth_options.sweeps = options.smooth_sweeps;
+        const MapSmoothingResult smoothed = smooth_map(model, P, sampled, smooth_options);
+        out->on_model_xyz = smoothed.polycube_on_model_xyz;
+        out->on_polycube_xyz = smoothed.model_on_polycube_xyz;
+        out->smooth_seconds = smoothed.seconds;
+        out->smoothing = {{"sweeps", smoothed.sweeps},
+                          {"rounds", smoothed.rounds},
+                          {"moves", smoothed.moves},
+                          {"rejected", smoothed.rejected},
+                          {"frozen_polycube_vertices", smoothed.frozen},
+                          {"relocated_model_vertices", smoothed.relocated},
+                          {"seconds", smoothed.seconds},
+                          {"before", {{"polycube_to_model_flipped", smoothed.flipped_before[0]},
+                                      {"model_to_polycube_flipped", smoothed.flipped_before[1]},
+                                      {"eps_angle", before.eps_angle},
+                                      {"eps_area", before.eps_area},
+                                      {"angle_p95", before.angle_p95},
+                                      {"angle_max", before.angle_max}}}};
+        progress.stage("smooth", std::to_string(smoothed.flipped_before[0]) + " / " + std::to_string(smoothed.flipped_before[1]) +
+                                     " flipped before, " + std::to_string(smoothed.flipped_after[0]) + " / " +
+                                     std::to_string(smoothed.flipped_after[1]) + " after");
+        if (options.refine) {
+          progress.stage("refine", "again where the smoothed map's chords flip or lose area");
+          PolycubeMap samples;
+          samples.polycube_on_model = smoothed.polycube_on_model;
+          samples.polycube_on_model_xyz = smoothed.polycube_on_model_xyz;
+          samples.model_on_polycube = smoothed.model_on_polycube;
+          samples.model_on_polycube_xyz = smoothed.model_on_polycube_xyz;
+          // Nothing moves the images after this: refine only where the audit's 2 % is not met
+          // (it then aims at half of that).
+          MapRefinementOptions resample_options;
+          resample_options.area_tolerance = MapAuditOptions().area_tolerance;
+          out->resampling = std::make_unique<MapRefinementResult>(
+              refine_vertex_map_sampling(model, P, polycube->planes_z, samples, resample_options));
+          out->polycube = &out->resampling->polycube;
+          out->on_model_xyz = out->resampling->map.polycube_on_model_xyz;
+          out->on_polycube_xyz = out->resampling->map.model_on_polycube_xyz;
+          out->resample_seconds = out->resampling->seconds;
+          out->resampling_report = refinement_json(*out->resampling);
+          progress.stage("refine", refinement_line(*out->resampling));
+        }
+      }
+      out->audit = audit_map(model, out->polycube->mesh, out->on_model_xyz, out->on_polycube_xyz);
+      return out;
+    };
+
+    std::unique_ptr<Finished> result;
+    nlohmann::json refinement_report = nullptr;
+    if (options.refine) {
+      progress.stage("refine", "bisecting P's triangles where the map sampled at its vertices flips or loses area");
+      refinement = refine_map_sampling(model, *polycube, *map);
+      progress.stage("refine", refinement_line(*refinement));
+      refinement_report = {{"map", refinement_json(*refinement)}};
+      double refine_seconds = refinement->seconds;
+      std::unique_ptr<Finished> refined = finish(refinement->polycube, refinement->map);
+      refine_seconds += refined->resample_seconds;
+      refinement_report["smoothed"] = refined->resampling_report;
+      if (refinement->refined) {
+        // The smoothing of a refined sampling can end worse than that of the unrefined one (it
+        // is a different problem): the refined result is kept only if neither direction has
+        // more bad triangles, or both together have fewer, than the unrefined P's result.
+        progress.stage("refine", "comparing with the unrefined P's smoothed map");
+        std::unique_ptr<Finished> unrefined = finish(polycube->polycube, *map);
+        refine_seconds += unrefined->resample_seconds;
+        const bool keep = (refined->bad_p() <= unrefined->bad_p() && refined->bad_m() <= unrefined->bad_m()) ||
+                          refined->bad_p() + refined->bad_m() < unrefined->bad_p() + unrefined->bad_m();
+        refinement_report["kept"] = keep;
+        refinement_report["unrefined"] = {{"polycube_to_model", direction_json(unrefined->audit.polycube_to_model)},
+                                          {"model_to_polycube", direction_json(unrefined->audit.model_to_polycube)},
+                                          {"smoothed", unrefined->resampling_report}};
+        seconds["smooth_unrefined"] = unrefined->smooth_seconds;
+        progress.stage("refine", std::string(keep ? "kept" : "dropped") + " (refined P " + std::to_string(refined->bad_p()) + " / " +
+                                     std::to_string(refined->bad_m()) + " flipped, unrefined P " + std::to_string(unrefined->bad_p()) +
+                                     " / " + std::to_string(unrefined->bad_m()) + ")");
+        result = keep ? std::move(refined) : std::move(unrefined);
+      } else {
+        refinement_report["kept"] = false;
+        result = std::move(refined);
+      }
+      seconds["refine"] = refine_seconds;
+    } else {
+      result = finish(polycube->polycube, *map);
     }
-    const MapAudit audit = audit_map(model, polycube->polycube.mesh, on_model_xyz, on_polycube_xyz);
+    if (options.smooth_sweeps > 0) seconds["smooth"] = result->smooth_seconds;
+    written_polycube = result->polycube;
+    finished = std::move(result);
+    const Polycube& P = *written_polycube;
+    on_model_xyz = finished->on_model_xyz;
+    on_polycube_xyz = finished->on_polycube_xyz;
+    const nlohmann::json& smoothing = finished->smoothing;
+    write_mesh(polycube_path, mesh_to_input(P.mesh));
+    outputs.push_back(polycube_path);
+    const MapAudit& audit = finished->audit;
     report["map"] = {{"contours", map->contours},
                      {"pieces", map->pieces.size()},
                      {"slits", slits},
@@ -284,8 +405,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"angle_max", audit.distortion.angle_max},
                      {"area_p95", audit.distortion.area_p95},
                      {"area_max", audit.distortion.area_max},
+                     {"refinement", refinement_report},
                      {"smoothing", smoothing}};
-    TriMesh on_model = polycube->polycube.mesh;
+    TriMesh on_model = P.mesh;
     on_model.V = to_input(on_model_xyz);
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
     write_mesh(on_model_path, on_model);
@@ -307,7 +429,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   outputs.push_back(pieces_path);
   const std::string preview_path = (dir / "preview.png").string();
   if (map)
-    write_map_preview(preview_path, model, polycube->polycube, on_polycube_xyz);
+    write_map_preview(preview_path, model, *written_polycube, on_polycube_xyz);
   else if (polycube)
     write_polycube_preview(preview_path, *polycube);
   else
@@ -350,6 +472,8 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "Sweeps per round of the map's smoothing (paper §3.5; never adds a flipped triangle); 0: no smoothing")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
+  command->add_flag("--no-refine{false}", options->refine,
+                   "Keep P's triangulation as built: do not refine it where the map sampled at its vertices flips or loses area");
   command->add_option("--stage", options->stage, "Stop after this stage")
       ->capture_default_str()
       ->check(CLI::IsMember(kStages));

@@ -34,7 +34,7 @@ struct QuadCommandOptions {
   int target_faces = 10000;
   double cell_size = 0;
   std::string map_dir;
-  int smooth = 0;
+  int smooth = 60;
   std::string report_path;
   std::string preview_path;
   std::string align = "auto";
@@ -48,6 +48,9 @@ std::string lower_extension(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
+
+// Above this Hausdorff distance (% of the diagonal) the result is flagged (issue 7's bound).
+constexpr double kHausdorffWarnPercent = 0.5;
 
 std::string percent(double x) {
   char text[32];
@@ -123,6 +126,13 @@ nlohmann::json quality_json(const QuadQuality& q) {
           {"max_vertex_distance", q.max_distance_to_surface},
           {"hausdorff", q.hausdorff_measured ? nlohmann::json(q.hausdorff) : nlohmann::json()},
           {"hausdorff_percent_diagonal", q.hausdorff_measured ? nlohmann::json(q.hausdorff_percent) : nlohmann::json()},
+          {"hausdorff_sides",
+           q.hausdorff_measured ? nlohmann::json{{"quads_to_model", q.quads_to_model},
+                                                 {"model_to_quads", q.model_to_quads},
+                                                 {"farthest_on_quads", {q.farthest_on_quads.x(), q.farthest_on_quads.y(), q.farthest_on_quads.z()}},
+                                                 {"farthest_on_model", {q.farthest_on_model.x(), q.farthest_on_model.y(), q.farthest_on_model.z()}},
+                                                 {"mean", q.mean_distance}}
+                                : nlohmann::json()},
           {"diagonal", q.diagonal}};
 }
 
@@ -169,9 +179,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     // images are turned back into the input's frame.
     Alignment alignment;
     Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-    if (options.align == "auto") {
-      progress.stage("align", "6 orientations (input frame, principal axes): polycubes, then maps of the 3 with fewest corners, scored by flips");
-      alignment = choose_alignment(model, options.topology, options.polycube);
+    if (options.align == "auto" || options.align == "corners") {
+      AlignmentOptions align_options;
+      if (options.align == "corners") align_options.mapped_candidates = 0;
+      progress.stage("align", options.align == "auto"
+                                  ? "6 orientations (input frame, principal axes): polycubes, then maps of the 3 with fewest corners, scored by flips"
+                                  : "6 orientations (input frame, principal axes): the polycube with the fewest corners");
+      alignment = choose_alignment(model, options.topology, options.polycube, align_options);
       if (alignment.chosen >= 0) {
         rotation = alignment.rotation;
         progress.stage("align", alignment.candidates[alignment.chosen].name);
@@ -216,8 +230,27 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       remesh_quads(*polycube_mesh, to_model, *projector, remesh,
                    [&progress](const std::string& stage, const std::string& message) { progress.stage(stage, message); });
   const QuadQuality& q = result.quality;
-  if (q.flipped_quads > 0) progress.warning(std::to_string(q.flipped_quads) + " quads are flipped on the model");
-  if (q.degenerate_quads > 0) progress.warning(std::to_string(q.degenerate_quads) + " quads are degenerate");
+  // Everything the result falls short in, on stderr and in the report.
+  nlohmann::json warnings = nlohmann::json::array();
+  const auto warn = [&](const std::string& message) {
+    progress.warning(message);
+    warnings.push_back(message);
+  };
+  if (q.flipped_quads > 0) warn(std::to_string(q.flipped_quads) + " quads are flipped on the model");
+  if (q.degenerate_quads > 0) warn(std::to_string(q.degenerate_quads) + " quads are degenerate (zero area or a zero-length edge)");
+  const int layout_cells = result.grid.layout.num_quads();
+  if (options.cell_size <= 0 && q.quads > 3 * options.target_faces / 2)
+    warn("made " + std::to_string(q.quads) + " quads for --target-faces " + std::to_string(options.target_faces) +
+         (layout_cells > options.target_faces
+              ? ": the polycube's layout alone has " + std::to_string(layout_cells) + " cells (" +
+                    std::to_string(result.grid.corners.size()) + " corners), one quad each at least"
+              : ""));
+  if (q.hausdorff_measured && q.hausdorff_percent > kHausdorffWarnPercent) {
+    const Eigen::Vector3d& at = q.model_to_quads >= q.quads_to_model ? q.farthest_on_model : q.farthest_on_quads;
+    warn("the quads are up to " + percent(q.hausdorff_percent) + " % of the bounding-box diagonal from the model (" +
+         (q.model_to_quads >= q.quads_to_model ? "a part of the model the quads miss" : "quads off the model") +
+         ", near " + percent(at.x()) + " " + percent(at.y()) + " " + percent(at.z()) + ")");
+  }
 
   write_polygon_mesh(options.output, result.mesh.V, quad_polygons(result.mesh));
   seconds["grid"] = result.seconds_grid;
@@ -252,8 +285,10 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                       {"free_loops_removed", grid.free_loops},
                       {"layout_cells", grid.layout.num_quads()},
                       {"chords", grid.chords}};
-    report["smoothing"] = {{"sweeps", result.smoothing.sweeps}, {"moves", result.smoothing.moves}, {"refused", result.smoothing.rejected}};
+    report["smoothing"] = {{"sweeps", result.smoothing.sweeps}, {"moves", result.smoothing.moves}, {"refused", result.smoothing.rejected},
+                           {"converged", result.smoothing.converged}, {"largest_move", result.smoothing.largest_move}};
     report["quality"] = quality_json(q);
+    report["warnings"] = warnings;
     report["seconds"] = seconds;
     report["output"] = options.output;
     write_text_atomically(options.report_path, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
@@ -283,7 +318,7 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
                           ->check(CLI::PositiveNumber);
   target->excludes(size);
   command->add_option("--map", options->map_dir, "Directory written by `polycube map` (reuses its map instead of building one)");
-  command->add_option("--smooth", options->smooth, "Tangential relaxation sweeps on the model (never flip a quad)")
+  command->add_option("--smooth", options->smooth, "Relaxation sweeps on the model at most, towards right angles and even sizes (stops when converged; never flips a quad; 0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0, 10000));
   command->add_option("--report", options->report_path, "Write the quality report as JSON to this file");
@@ -291,9 +326,11 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
   command->add_option("--smooth-sweeps", options->smooth_map_sweeps, "Sweeps of the map smoothing before carrying the grid (as `map --smooth-sweeps`; 0: the unsmoothed map; not with --map)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
-  command->add_option("--align", options->align, "Orientation search as for `map` (auto | none; not with --map)")
+  command->add_option("--align", options->align,
+                      "Orientation search (not with --map): auto as for `map` (fewest corners, then maps scored by flips); "
+                      "corners: fewest polycube corners only (no candidate maps, faster); none: the input's orientation")
       ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "none"}));
+      ->check(CLI::IsMember({"auto", "corners", "none"}));
   command->add_option("--dz", options->topology.dz, "Largest gap between cutting planes, unit-cube units (paper's d_z; not with --map)")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));

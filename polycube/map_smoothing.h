@@ -41,8 +41,35 @@
 //      their input images and the model vertices over them theirs, so frozen places carry the
 //      input map in both directions, whose directions agree. The round with the fewest flips in
 //      all, and no more than the input's in either direction, is returned; if none, the input.
+//   4. Untangling, while flips remain (at most 4 passes): the rounds of 1–3 restricted to the
+//      vertices within a few edges of the flipped triangles of one direction, the rest frozen,
+//      first with the roles of the meshes swapped — M's vertices move on P (M's fans and
+//      cotangent weights; the guard judges M's image triangles on P) and P's vertices whose image
+//      lies in a model triangle with a moved corner are relocated among M's triangles drawn on P,
+//      as in step 2 — then P's vertices on M again, near the P → M flips. In these phases a vertex
+//      of a bad triangle first tries the point of its tangent plane where the smallest triangle of
+//      its fan (the neighbours' images projected) is largest, taken only if it leaves fewer bad
+//      triangles round the vertex and turns no good one bad. The M-side phase is first run
+//      letting P → M get worse (the P-side phase then repairs it), and if that pair does not pay,
+//      with neither direction allowed to get worse. Each pass tries 0, 1, r, 2r, 3r + 1 and 5r
+//      rings round the flipped triangles (r = untangle_rings; which is best differs from mesh to
+//      mesh) and keeps the outcome with the fewest flips, then the fewest M → P flips; a pass is kept
+//      only if it leaves neither direction worse and lowers the flips in all, so the untangling
+//      never adds a flip.
+//      Diagnosis behind it (dev meshes; scratch tools, default parameters): the M → P flips that
+//      steps 1–3 leave are small M triangles (under one P triangle's area) almost all next to the
+//      cutting contours and P's corners; their three images are squeezed across the contour (the
+//      disk maps of the two pieces compress the contour-normal direction 10–30× and shear it
+//      there). Many are truly reversed (on one flat face of P, or on two faces unfolded across
+//      their edge); on thin parts (anchor) many span two opposite parallel faces of P, where the
+//      audit's "normal nearby" is a sum of opposite normals. Even the continuous φ⁻¹ sampled inside one model
+//      face and one P triangle has reversed sub-triangles (cow: 38 of 199648), where the two
+//      disk maps are strongly anisotropic in different directions: the harmonic disk maps with
+//      an arc-length boundary are far from conformal on long pieces. Moving M's vertices on P
+//      removes most of those flips; the rest needs better disk maps (see the report of issue 5).
 // Every image is a point of a face (face + barycentrics), so images lie on the surfaces to
-// rounding. What it cannot do: untangle regions where the input map folds over many triangles
+// rounding.
+// What it cannot do: untangle regions where the input map folds over many triangles
 // (they stay frozen as the input had them), or lower the distortion that P's corners force.
 #pragma once
 
@@ -67,6 +94,9 @@ struct MapSmoothingOptions {
   // neighbours' average (then 1, ½, ¼ if that spoils a triangle). 1.5 roughly halves the sweeps
   // needed for the same angle distortion on the paper's models.
   double relaxation = 1.5;
+  // The untangling (step 4 at the top): the base number r of edges round a flipped triangle
+  // within which vertices may move (each pass tries 0, 1, r, 2r, 3r + 1 and 5r); 0: no untangling.
+  int untangle_rings = 3;
 };
 
 // The smoothed map at the vertices of both meshes, and what it took.
@@ -75,7 +105,9 @@ struct MapSmoothingOptions {
 //   model_on_polycube      per vertex of the model: φ⁻¹(w) as a point of P
 //   model_on_polycube_xyz  the same as positions
 //   sweeps, moves, rejected  Gauss–Seidel sweeps run, vertex moves taken, and moves refused even
-//                          at a quarter step (summed over all rounds)
+//                          at a quarter step (summed over all rounds of the smoothing proper)
+//   untangle_phases        untangling phases kept (in passes that lowered the flips in all)
+//   untangle_sweeps, untangle_moves  sweeps run and moves taken in all untangling phases tried
 //   rounds                 rounds run; the returned map is the best of them
 //   frozen                 P vertices that keep their input images in the returned map (all of
 //                          them when no round was as good as the input)
@@ -94,6 +126,9 @@ struct MapSmoothingResult {
   int rounds = 0;
   int frozen = 0;
   int relocated = 0;
+  int untangle_phases = 0;
+  int untangle_sweeps = 0;
+  int untangle_moves = 0;
   std::array<int, 2> flipped_before{0, 0}, flipped_after{0, 0};
   double seconds = 0;
 };

@@ -14,7 +14,7 @@ constexpr double kDegrees = 57.29577951308232;
 }  // namespace
 
 Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const Eigen::Vector3d corners[4]) {
-  return surface.face_normal(surface.closest((corners[0] + corners[1] + corners[2] + corners[3]) / 4).face);
+  return quad_surface_normal(surface, surface.closest((corners[0] + corners[1] + corners[2] + corners[3]) / 4));
 }
 
 QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& reference, const std::vector<int>& corners,
@@ -79,6 +79,11 @@ QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& referen
     r.hausdorff_measured = true;
     r.hausdorff = d.hausdorff;
     r.hausdorff_percent = r.diagonal > 0 ? 100 * d.hausdorff / r.diagonal : 0;
+    r.quads_to_model = d.a_to_b;
+    r.model_to_quads = d.b_to_a;
+    r.farthest_on_quads = d.a_farthest;
+    r.farthest_on_model = d.b_farthest;
+    r.mean_distance = (d.mean_a_to_b + d.mean_b_to_a) / 2;
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

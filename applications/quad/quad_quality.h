@@ -35,6 +35,9 @@ struct QuadQualityOptions {
 //   max_distance_to_surface largest vertex distance to the reference surface
 //   hausdorff               sampled two-sided distance between the triangulated quads and the
 //                           reference (0 when not measured), hausdorff_percent of its diagonal
+//   quads_to_model, model_to_quads  the two one-sided distances (largest), and
+//   farthest_on_quads, farthest_on_model  where each occurs (to find what the quads miss)
+//   mean_distance           mean sample distance, both directions together
 //   diagonal                of the reference's bounding box
 struct QuadQuality {
   int quads = 0;
@@ -56,6 +59,11 @@ struct QuadQuality {
   bool hausdorff_measured = false;
   double hausdorff = 0;
   double hausdorff_percent = 0;
+  double quads_to_model = 0;
+  double model_to_quads = 0;
+  Eigen::Vector3d farthest_on_quads = Eigen::Vector3d::Zero();
+  Eigen::Vector3d farthest_on_model = Eigen::Vector3d::Zero();
+  double mean_distance = 0;
   double diagonal = 0;
   double seconds = 0;
 };
@@ -63,6 +71,11 @@ struct QuadQuality {
 // The surface's normal for a quad: that of the triangle closest to the quad's centre (a face
 // normal, so a quad on one face of a polycube gets exactly that face's normal).
 Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const Eigen::Vector3d corners[4]);
+// The same from a closest-point query already made for the centre (centre: the closest hit to
+// the mean of the corners), so callers can pass search hints.
+inline Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const SurfaceHit& centre) {
+  return surface.face_normal(centre.face);
+}
 
 // Measures quads against the surface they approximate.
 //   corners  vertex indices expected to be irregular (the polycube's corners), may be empty

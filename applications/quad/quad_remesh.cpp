@@ -39,14 +39,15 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
   result.seconds_carry = since(start);
 
   if (options.smooth.sweeps > 0) {
-    report("smooth", std::to_string(options.smooth.sweeps) + " tangential relaxation sweeps");
+    report("smooth", "up to " + std::to_string(options.smooth.sweeps) + " relaxation sweeps towards right angles");
     start = std::chrono::steady_clock::now();
     result.smoothing = smooth_quads(result.mesh, model, options.smooth);
     result.mesh = result.smoothing.mesh;
     result.smoothing.mesh = QuadMesh{};  // one copy is enough
     result.seconds_smooth = since(start);
-    report("smooth", std::to_string(result.smoothing.moves) + " moves, " + std::to_string(result.smoothing.rejected) +
-                         " refused (would flip a quad)");
+    report("smooth", std::to_string(result.smoothing.sweeps) + " sweeps" + (result.smoothing.converged ? " (converged), " : ", ") +
+                         std::to_string(result.smoothing.moves) + " moves, " + std::to_string(result.smoothing.rejected) +
+                         " refused (would flip a quad or leave the surface under the vertex)");
   }
 
   if (options.measure) {

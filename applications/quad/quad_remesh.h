@@ -4,7 +4,7 @@
 //   grid    = build_polycube_grid(P, φ)         quads on P, irregular only at P's corners,
 //                                               chords sized by their length on M
 //   quads   = carry_grid(grid, map)             the same quads on M
-//   quads   = smooth_quads(quads, M)            optional, never flips a quad
+//   quads   = smooth_quads(quads, M)            optional: towards right angles, never flips a quad
 //   quality = measure_quads(quads, M, corners)
 #pragma once
 

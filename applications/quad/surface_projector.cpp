@@ -50,6 +50,9 @@ struct SurfaceProjector::Impl {
   Eigen::MatrixX3d vertex_normals;
   std::vector<Triangle> triangles;
   Tree tree;
+
+  // The hit for a query whose closest point on the surface is `point`, on triangle `face`.
+  SurfaceHit hit(const Eigen::Vector3d& query, const Eigen::Vector3d& point, int face) const;
 };
 
 SurfaceProjector::SurfaceProjector(const TriMesh& surface) : impl_(std::make_unique<Impl>()) {
@@ -83,12 +86,24 @@ SurfaceProjector::~SurfaceProjector() = default;
 SurfaceHit SurfaceProjector::closest(const Eigen::Vector3d& query) const {
   const Point q(query.x(), query.y(), query.z());
   const auto [point, face] = impl_->tree.closest_point_and_primitive(q);
+  return impl_->hit(query, {point.x(), point.y(), point.z()}, face);
+}
+
+SurfaceHit SurfaceProjector::closest(const Eigen::Vector3d& query, const SurfaceHit& hint) const {
+  if (hint.face < 0 || hint.face >= impl_->surface.num_faces()) return closest(query);
+  const Point q(query.x(), query.y(), query.z());
+  const auto [point, face] =
+      impl_->tree.closest_point_and_primitive(q, {Point(hint.point.x(), hint.point.y(), hint.point.z()), hint.face});
+  return impl_->hit(query, {point.x(), point.y(), point.z()}, face);
+}
+
+SurfaceHit SurfaceProjector::Impl::hit(const Eigen::Vector3d& query, const Eigen::Vector3d& point, int face) const {
   SurfaceHit hit;
-  hit.point = {point.x(), point.y(), point.z()};
+  hit.point = point;
   hit.face = face;
   hit.distance = (hit.point - query).norm();
   // Barycentric coordinates of the point in its triangle (areas of the opposite sub-triangles).
-  const TriMesh& m = impl_->surface;
+  const TriMesh& m = surface;
   const Eigen::Vector3d a = m.V.row(m.F(face, 0)), b = m.V.row(m.F(face, 1)), c = m.V.row(m.F(face, 2));
   const Eigen::Vector3d n = (b - a).cross(c - a);
   const double area = n.squaredNorm();
@@ -96,11 +111,11 @@ SurfaceHit SurfaceProjector::closest(const Eigen::Vector3d& query) const {
     const double wa = std::max(0.0, (c - b).cross(hit.point - b).dot(n) / area);
     const double wb = std::max(0.0, (a - c).cross(hit.point - c).dot(n) / area);
     const double wc = std::max(0.0, (b - a).cross(hit.point - a).dot(n) / area);
-    hit.normal = wa * impl_->vertex_normals.row(m.F(face, 0)) + wb * impl_->vertex_normals.row(m.F(face, 1)) +
-                 wc * impl_->vertex_normals.row(m.F(face, 2));
+    hit.normal = wa * vertex_normals.row(m.F(face, 0)) + wb * vertex_normals.row(m.F(face, 1)) +
+                 wc * vertex_normals.row(m.F(face, 2));
   }
   const double length = hit.normal.norm();
-  hit.normal = length > 1e-12 ? (hit.normal / length).eval() : impl_->normals.row(face).transpose().eval();
+  hit.normal = length > 1e-12 ? (hit.normal / length).eval() : normals.row(face).transpose().eval();
   return hit;
 }
 

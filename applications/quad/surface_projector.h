@@ -35,6 +35,9 @@ class SurfaceProjector {
   SurfaceProjector& operator=(const SurfaceProjector&) = delete;
 
   SurfaceHit closest(const Eigen::Vector3d& query) const;
+  // The same, starting the search from a known surface point (a previous hit near the query, as
+  // for a vertex that moves a little): faster, same answer.
+  SurfaceHit closest(const Eigen::Vector3d& query, const SurfaceHit& hint) const;
 
   const TriMesh& surface() const;
   // Unit outward normal of triangle f (zero for a degenerate one).

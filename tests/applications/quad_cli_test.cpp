@@ -44,7 +44,7 @@ TEST(QuadCli, MapDirectoryOfTheIdentity) {
   write_mesh(dir + "/polycube_on_model.obj", built.polycube.mesh);
   const std::string out = dir + "/quads.obj", report_path = dir + "/report.json";
   const test::CliRun run = polycube_cli("quad " + quoted(dir + "/polycube.obj") + " -o " + quoted(out) + " --map " + quoted(dir) +
-                                        " --target-faces 3000 --report " + quoted(report_path) + " --quiet");
+                                        " --target-faces 3000 --smooth 0 --report " + quoted(report_path) + " --quiet");
   ASSERT_EQ(run.code, 0) << run.err;
   EXPECT_TRUE(run.err.empty()) << run.err;
   const QuadMesh quads = read_quads(out);
@@ -60,6 +60,18 @@ TEST(QuadCli, MapDirectoryOfTheIdentity) {
   EXPECT_EQ(report["quality"]["irregular_vertices"], report["quality"]["irregular_at_corners"]);
   EXPECT_NEAR(report["quality"]["quads"].get<double>(), 3000, 450);
   EXPECT_EQ(report["parameters"]["map"], dir);
+  ASSERT_TRUE(report["warnings"].is_array());
+  EXPECT_TRUE(report["warnings"].empty()) << report["warnings"].dump();
+  EXPECT_LE(report["quality"]["hausdorff_sides"]["model_to_quads"].get<double>(), report["quality"]["hausdorff"].get<double>());
+
+  // Far fewer quads asked than P's layout has cells: made anyway, and said so.
+  const test::CliRun few = polycube_cli("quad " + quoted(dir + "/polycube.obj") + " -o " + quoted(out) + " --map " + quoted(dir) +
+                                        " --target-faces 10 --smooth 0 --report " + quoted(report_path));
+  ASSERT_EQ(few.code, 0) << few.err;
+  EXPECT_NE(few.err.find("layout alone has"), std::string::npos) << few.err;
+  const nlohmann::json few_report = nlohmann::json::parse(test::read_file(report_path));
+  EXPECT_GT(few_report["quality"]["quads"].get<int>(), 15);
+  EXPECT_EQ(few_report["warnings"].size(), 1u) << few_report["warnings"].dump();
 }
 
 TEST(QuadCli, MapBuiltInMemory) {

@@ -161,6 +161,40 @@ TEST(MapSmoothing, MoreSweepsLowerAngleDistortionFurther) {
   }
 }
 
+// The untangling phases (M's vertices moved on P near the M → P flips the smoothing proper leaves,
+// P's vertices relocated over them, then P's near the P → M flips): on the coarse test meshes
+// that keep flips after the sweeps over P's vertices, neither direction ends worse than without
+// them, and in all they remove M → P flips.
+TEST(MapSmoothing, UntanglingRemovesModelToPolycubeFlipsAndNeverAddsAny) {
+  int without_m = 0, with_m = 0, phases = 0;
+  for (const std::string name : {"joint.off", "helmet.off", "couplingdown.off"}) {
+    const Pipeline& p = pipeline(name);
+    const TriMesh& P = p.polycube.polycube.mesh;
+    MapSmoothingOptions plain;
+    plain.untangle_rings = 0;
+    const MapSmoothingResult a = smooth_map(p.model, p.polycube.polycube, p.map, plain);
+    const MapSmoothingResult b = smooth_map(p.model, p.polycube.polycube, p.map);
+    EXPECT_EQ(a.untangle_phases, 0) << name;
+    EXPECT_EQ(a.untangle_moves, 0) << name;
+    const MapAudit audit_a = audit_map(p.model, P, a.polycube_on_model_xyz, a.model_on_polycube_xyz);
+    const MapAudit audit_b = audit_map(p.model, P, b.polycube_on_model_xyz, b.model_on_polycube_xyz);
+    EXPECT_EQ(b.flipped_after[0], bad(audit_b.polycube_to_model)) << name;
+    EXPECT_EQ(b.flipped_after[1], bad(audit_b.model_to_polycube)) << name;
+    EXPECT_LE(bad(audit_b.polycube_to_model), bad(audit_a.polycube_to_model)) << name;
+    EXPECT_LE(bad(audit_b.model_to_polycube), bad(audit_a.model_to_polycube)) << name;
+    EXPECT_LT(audit_b.polycube_to_model.max_distance, 1e-9) << name;
+    EXPECT_LT(audit_b.model_to_polycube.max_distance, 1e-9) << name;
+    // A kept phase lowered the flips in all.
+    if (b.untangle_phases > 0) EXPECT_LT(b.flipped_after[0] + b.flipped_after[1], a.flipped_after[0] + a.flipped_after[1]) << name;
+    else EXPECT_EQ(b.model_on_polycube_xyz, a.model_on_polycube_xyz) << name;
+    without_m += bad(audit_a.model_to_polycube);
+    with_m += bad(audit_b.model_to_polycube);
+    phases += b.untangle_phases;
+  }
+  EXPECT_GT(phases, 0);
+  EXPECT_LT(with_m, without_m);
+}
+
 TEST(MapSmoothing, RejectsMismatchedInput) {
   const Pipeline& p = pipeline("sphere.off");
   PolycubeMap truncated = p.map;
@@ -174,6 +208,9 @@ TEST(MapSmoothing, RejectsMismatchedInput) {
   EXPECT_THROW(smooth_map(p.model, p.polycube.polycube, p.map, options), std::invalid_argument);
   options.rounds = 1;
   options.sweeps = -1;
+  EXPECT_THROW(smooth_map(p.model, p.polycube.polycube, p.map, options), std::invalid_argument);
+  options.sweeps = 10;
+  options.untangle_rings = -1;
   EXPECT_THROW(smooth_map(p.model, p.polycube.polycube, p.map, options), std::invalid_argument);
 }
 

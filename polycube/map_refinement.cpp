@@ -1,0 +1,881 @@
+#include "polycube/map_refinement.h"
+
+#include "polycube/parallel.h"
+#include "polycube/triangle_tree.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <numeric>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace polycube {
+
+namespace {
+
+using namespace triangle_tree;
+using Vec3 = Eigen::Vector3d;
+using Clock = std::chrono::steady_clock;
+
+// Edges crossing a cutting plane are split on it when that is at least this far from their ends
+// (as a fraction of their length); otherwise at their midpoint.
+constexpr double kPlaneSplitMin = 0.1;
+
+// Image triangles at or below this fraction of the target area are degenerate (the audit's).
+constexpr double kDegenerateArea = 1e-14;
+
+Vec3 row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpose(); }
+
+// Runs work(i) for i in [0, n) on `threads` threads, in interleaved blocks.
+template <class Work>
+void parallel_range(int n, int threads, Work&& work) {
+  if (n <= 0) return;
+  constexpr int kBlocks = 64;
+  std::vector<int> blocks(std::min(kBlocks, n));
+  std::iota(blocks.begin(), blocks.end(), 0);
+  const int stride = static_cast<int>(blocks.size());
+  parallel_for_each(blocks, threads, "block", [&](int block) {
+    for (int i = block; i < n; i += stride) work(i);
+  });
+}
+
+// The audit's judgement of image triangles on the model (map_audit.cpp, audit_map_direction):
+// closest faces from the same AABB tree over the same triangles (zero-area faces left out), so
+// every tie is broken the same way.
+class AuditTarget {
+ public:
+  explicit AuditTarget(const TriMesh& target) {
+    for (int f = 0; f < target.num_faces(); ++f) {
+      const Vec3 a = row(target.V, target.F(f, 0));
+      area_vectors_.push_back((row(target.V, target.F(f, 1)) - a).cross(row(target.V, target.F(f, 2)) - a));
+      area_ += 0.5 * area_vectors_.back().norm();
+      if (area_vectors_.back().squaredNorm() == 0) continue;
+      triangles_.emplace_back(point(target, target.F(f, 0)), point(target, target.F(f, 1)), point(target, target.F(f, 2)));
+      faces_.push_back(f);
+    }
+    if (triangles_.empty()) throw std::invalid_argument("refine_map_sampling: the model has zero area");
+    tree_.rebuild(triangles_.begin(), triangles_.end());
+    tree_.accelerate_distance_queries();
+    diagonal_ = bounding_box(target.V).diagonal();
+  }
+  AuditTarget(const AuditTarget&) = delete;
+  AuditTarget& operator=(const AuditTarget&) = delete;
+
+  // Closest target face to p and the distance to it.
+  std::pair<int, double> closest(const Vec3& p) const {
+    const Point q(p.x(), p.y(), p.z());
+    const auto [hit, id] = tree_.closest_point_and_primitive(q);
+    return {faces_[static_cast<size_t>(id - triangles_.begin())], std::sqrt(CGAL::squared_distance(q, hit))};
+  }
+
+  // 0: good, 1: flipped, 2: degenerate — the image triangle (a, b, c) whose corners' closest
+  // faces are fa, fb, fc.
+  int judge(const Vec3& a, const Vec3& b, const Vec3& c, int fa, int fb, int fc) const {
+    const Vec3 n = (b - a).cross(c - a);
+    if (0.5 * n.norm() <= kDegenerateArea * area_) return 2;
+    int faces[4] = {closest((a + b + c) / 3).first, fa, fb, fc};
+    std::sort(faces, faces + 4);
+    Vec3 nearby = Vec3::Zero();
+    for (int k = 0; k < 4; ++k)
+      if (k == 0 || faces[k] != faces[k - 1]) nearby += area_vectors_[faces[k]];
+    return n.dot(nearby) <= 0 ? 1 : 0;
+  }
+
+  // The closest point of the target to p, as a point of a target face.
+  SurfacePoint closest_point(const TriMesh& target, const Vec3& p) const {
+    const Point q(p.x(), p.y(), p.z());
+    const auto [hit, id] = tree_.closest_point_and_primitive(q);
+    SurfacePoint out;
+    out.face = faces_[static_cast<size_t>(id - triangles_.begin())];
+    const Vec3 a = row(target.V, target.F(out.face, 0)), b = row(target.V, target.F(out.face, 1)), c = row(target.V, target.F(out.face, 2));
+    const Vec3 x(hit.x(), hit.y(), hit.z());
+    const Vec3 n = (b - a).cross(c - a);
+    const double nn = n.squaredNorm();
+    out.bary = Vec3((c - b).cross(x - b).dot(n) / nn, (a - c).cross(x - c).dot(n) / nn, 0);
+    out.bary[2] = 1 - out.bary[0] - out.bary[1];
+    out.bary = out.bary.cwiseMax(0.0);
+    out.bary /= out.bary.sum();
+    return out;
+  }
+
+  double area() const { return area_; }
+  double diagonal() const { return diagonal_; }
+
+ private:
+  std::vector<Vec3> area_vectors_;
+  std::vector<Triangle> triangles_;
+  std::vector<int> faces_;
+  double area_ = 0;
+  double diagonal_ = 0;
+  Tree tree_;
+};
+
+double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) { return 0.5 * (b - a).cross(c - a).norm(); }
+
+uint64_t edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
+}
+
+// The refined triangulation of P and the map sampled at its vertices. Triangle t has corners
+// tri[t], neighbour adj[t][i] across its edge from corner i to i + 1, and lies in the unrefined
+// face parent[t], where its corners have barycentric coordinates bary[t].
+struct Sampling {
+  std::vector<Vec3> position;
+  std::vector<SurfacePoint> origin;  // per vertex: on the unrefined P
+  std::vector<SurfacePoint> image;   // per vertex: φ on the model
+  std::vector<Vec3> image_xyz;
+  std::vector<int> image_face;       // per vertex: the model face closest to its image (audit's)
+  std::vector<double> image_distance;  // per vertex: its image's distance from the model
+  std::vector<std::array<int, 3>> tri, adj;
+  std::vector<std::array<Vec3, 3>> bary;
+  std::vector<int> parent, level;
+  std::vector<char> state;           // per triangle: 0 good, 1 flipped, 2 degenerate, -1 unknown
+  std::vector<std::pair<uint64_t, int>> splits;  // (edge, its new vertex), in order
+  int bisections = 0;
+};
+
+// A point splitting an edge: the parameter from its smaller vertex id and the image of φ there.
+struct SplitPoint {
+  double s = 0.5;
+  Vec3 position = Vec3::Zero();
+  SurfacePoint origin;
+  SurfacePoint image;
+  Vec3 image_xyz = Vec3::Zero();
+};
+
+// The map to sample: a point of the base P (the mesh being refined) to a point of the model.
+using Evaluator = std::function<SurfacePoint(const SurfacePoint&)>;
+
+class Refiner {
+ public:
+  // frozen: per face of `polycube`, 1 if it must not be split.
+  Refiner(const TriMesh& model, const Polycube& polycube, const std::vector<double>& planes, const PolycubeMap& map, Evaluator evaluate,
+          const std::vector<char>& frozen, const MapRefinementOptions& options)
+      : model_(model), evaluate_(std::move(evaluate)), options_(options), target_(model), planes_(planes), frozen_(frozen) {
+    std::sort(planes_.begin(), planes_.end());
+    const TriMesh& P = polycube.mesh;
+    Sampling& s = now_;
+    const int nv = P.num_vertices(), nf = P.num_faces();
+    s.position.resize(nv);
+    s.origin.resize(nv);
+    s.image = map.polycube_on_model;
+    s.image_xyz.resize(nv);
+    for (int v = 0; v < nv; ++v) {
+      s.position[v] = row(P.V, v);
+      s.image_xyz[v] = row(map.polycube_on_model_xyz, v);
+    }
+    s.tri.resize(nf);
+    s.adj.resize(nf);
+    s.bary.resize(nf);
+    s.parent.resize(nf);
+    s.level.assign(nf, 0);
+    s.state.assign(nf, -1);
+    std::unordered_map<uint64_t, std::pair<int, int>> half;  // directed edge (a, b) -> (face, corner)
+    half.reserve(3 * nf);
+    for (int f = 0; f < nf; ++f) {
+      s.parent[f] = f;
+      for (int i = 0; i < 3; ++i) {
+        s.tri[f][i] = P.F(f, i);
+        s.bary[f][i] = Vec3::Unit(i);
+        s.origin[P.F(f, i)] = SurfacePoint{f, Vec3::Unit(i)};
+        half[directed(P.F(f, i), P.F(f, (i + 1) % 3))] = {f, i};
+      }
+    }
+    for (int f = 0; f < nf; ++f)
+      for (int i = 0; i < 3; ++i) {
+        const auto it = half.find(directed(P.F(f, (i + 1) % 3), P.F(f, i)));
+        if (it == half.end()) throw std::invalid_argument("refine_map_sampling: the polycube mesh is not closed");
+        s.adj[f][i] = it->second.first;
+      }
+    s.image_face.assign(nv, -1);
+    s.image_distance.assign(nv, 0);
+    parallel_range(nv, options.threads, [&](int v) { std::tie(s.image_face[v], s.image_distance[v]) = target_.closest(s.image_xyz[v]); });
+    judge_unknown();
+  }
+
+  // Bad (flipped or degenerate) triangles and the total image area of the current sampling.
+  std::pair<int, double> measure() const {
+    int bad = 0;
+    double area = 0;
+    for (size_t t = 0; t < now_.tri.size(); ++t) {
+      bad += now_.state[t] != 0;
+      area += image_area(static_cast<int>(t));
+    }
+    return {bad, area};
+  }
+
+  MapDirectionAudit audit() const {
+    MapDirectionAudit a;
+    a.triangles = static_cast<int>(now_.tri.size());
+    double area = 0;
+    for (size_t t = 0; t < now_.tri.size(); ++t) {
+      a.flipped += now_.state[t] == 1;
+      a.degenerate += now_.state[t] == 2;
+      area += image_area(static_cast<int>(t));
+    }
+    for (double d : now_.image_distance) a.max_distance = std::max(a.max_distance, d);
+    if (target_.diagonal() > 0) a.max_distance /= target_.diagonal();
+    a.area_ratio = area / target_.area();
+    const MapAuditOptions audit_options;
+    a.ok = a.flipped == 0 && a.degenerate == 0 && a.max_distance <= audit_options.surface_tolerance &&
+           std::abs(a.area_ratio - 1) <= audit_options.area_tolerance;
+    return a;
+  }
+
+  // One round: marks the bad triangles and those whose refinement gains the most missing area,
+  // refines each once. Returns false when nothing could be marked (or the budget is spent).
+  bool round(int max_vertices) {
+    const auto [bad, area] = measure();
+    const double missing = target_.area() - area;
+    std::vector<int> marked;
+    for (size_t t = 0; t < now_.tri.size(); ++t)
+      if (now_.state[t] != 0 && now_.level[t] < options_.max_level && failed_[t] != version_[t]) marked.push_back(static_cast<int>(t));
+    const size_t bad_marked = marked.size();
+    if (std::abs(missing) > options_.area_tolerance * target_.area()) {
+      // Gain of splitting each triangle into four at φ of its edge midpoints; the largest gains
+      // first, as many as cover the missing area down to half the tolerance.
+      const int nt = static_cast<int>(now_.tri.size());
+      prepare_splits(nt);
+      std::vector<double> gain(nt, 0);
+      parallel_range(nt, options_.threads, [&](int t) { gain[t] = split_gain(t); });
+      std::vector<int> order(nt);
+      std::iota(order.begin(), order.end(), 0);
+      std::sort(order.begin(), order.end(), [&](int a, int b) { return gain[a] != gain[b] ? gain[a] > gain[b] : a < b; });
+      const double need = missing > 0 ? missing - 0.5 * options_.area_tolerance * target_.area() : 0;
+      double sum = 0;
+      for (int t : order) {
+        if (sum >= need || gain[t] <= 0) break;
+        if (now_.level[t] >= options_.max_level || now_.state[t] != 0 || failed_[t] == version_[t]) continue;
+        marked.push_back(t);
+        sum += gain[t];
+      }
+    }
+    if (marked.empty()) return false;
+    // Marked triangles are identified by their slot and the slot's version: a slot refined by the
+    // closure of an earlier one counts as refined.
+    std::vector<int> version_at(marked.size());
+    for (size_t k = 0; k < marked.size(); ++k) version_at[k] = version_[marked[k]];
+    prepare_splits(static_cast<int>(now_.tri.size()), &marked);
+    bool any = false;
+    for (size_t k = 0; k < marked.size(); ++k) {
+      if (static_cast<int>(now_.position.size()) >= max_vertices) break;
+      if (version_[marked[k]] != version_at[k]) continue;
+      any |= refine(marked[k], k < bad_marked);
+    }
+    judge_unknown();
+    return any;
+  }
+
+  Sampling& sampling() { return now_; }
+
+ private:
+  static uint64_t directed(int a, int b) {
+    return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
+  }
+
+  double image_area(int t) const {
+    const auto& c = now_.tri[t];
+    return triangle_area(now_.image_xyz[c[0]], now_.image_xyz[c[1]], now_.image_xyz[c[2]]);
+  }
+
+  // Judges every triangle whose state is unknown, as the audit would.
+  void judge_unknown() {
+    std::vector<int> todo;
+    for (size_t t = 0; t < now_.tri.size(); ++t)
+      if (now_.state[t] < 0) todo.push_back(static_cast<int>(t));
+    version_.resize(now_.tri.size(), 0);
+    failed_.resize(now_.tri.size(), -1);
+    parallel_range(static_cast<int>(todo.size()), options_.threads, [&](int k) {
+      const auto& c = now_.tri[todo[k]];
+      now_.state[todo[k]] = static_cast<char>(target_.judge(now_.image_xyz[c[0]], now_.image_xyz[c[1]], now_.image_xyz[c[2]],
+                                                            now_.image_face[c[0]], now_.image_face[c[1]], now_.image_face[c[2]]));
+    });
+  }
+
+  // Where edge (a, b) is split, as the parameter from the smaller vertex id (so that both
+  // triangles of the edge agree) and the position: where it crosses a cutting plane, exactly on
+  // the plane (φ is glued there from two pieces' maps: its strongest kink, which chords across it
+  // never resolve at any scale) unless that is near an end; otherwise its midpoint.
+  std::pair<double, Vec3> split_parameter(int a, int b) const {
+    if (a > b) std::swap(a, b);
+    const Vec3& pa = now_.position[a];
+    const Vec3& pb = now_.position[b];
+    const double lo = std::min(pa.z(), pb.z()), hi = std::max(pa.z(), pb.z());
+    double best_s = 0.5, best_z = NAN;
+    for (auto it = std::upper_bound(planes_.begin(), planes_.end(), lo); it != planes_.end() && *it < hi; ++it) {
+      const double s = (*it - pa.z()) / (pb.z() - pa.z());
+      if (s >= kPlaneSplitMin && s <= 1 - kPlaneSplitMin && (std::isnan(best_z) || std::abs(s - 0.5) < std::abs(best_s - 0.5))) {
+        best_s = s;
+        best_z = *it;
+      }
+    }
+    Vec3 p = pa + best_s * (pb - pa);
+    if (!std::isnan(best_z)) p.z() = best_z;
+    return {best_s, p};
+  }
+
+  // The split point of triangle t's edge i (from corner i to i + 1), with φ there (evaluated once
+  // per edge and kept until the edge is split).
+  SplitPoint split_point(int t, int i) const {
+    const int a = now_.tri[t][i], b = now_.tri[t][(i + 1) % 3];
+    SplitPoint p;
+    std::tie(p.s, p.position) = split_parameter(a, b);
+    const double from_a = a < b ? p.s : 1 - p.s;  // parameter from a towards b
+    p.origin.face = now_.parent[t];
+    p.origin.bary = (1 - from_a) * now_.bary[t][i] + from_a * now_.bary[t][(i + 1) % 3];
+    p.image = evaluate_(p.origin);
+    p.image_xyz = surface_position(model_, p.image);
+    return p;
+  }
+
+  // Evaluates φ at the split points of every edge of triangles [0, nt) (or of `only`) not yet known.
+  void prepare_splits(int nt, const std::vector<int>* only = nullptr) {
+    std::vector<std::pair<int, int>> todo;  // (triangle, edge)
+    std::vector<uint64_t> keys;
+    auto add = [&](int t) {
+      for (int i = 0; i < 3; ++i) {
+        const uint64_t key = edge_key(now_.tri[t][i], now_.tri[t][(i + 1) % 3]);
+        if (cache_.count(key)) continue;
+        cache_[key] = SplitPoint{};  // placeholder, filled below
+        todo.emplace_back(t, i);
+        keys.push_back(key);
+      }
+    };
+    if (only)
+      for (int t : *only) add(t);
+    else
+      for (int t = 0; t < nt; ++t) add(t);
+    std::vector<SplitPoint> points(todo.size());
+    parallel_range(static_cast<int>(todo.size()), options_.threads, [&](int k) { points[k] = split_point(todo[k].first, todo[k].second); });
+    for (size_t k = 0; k < todo.size(); ++k) cache_[keys[k]] = points[k];
+  }
+
+  const SplitPoint& cached_split(int t, int i) {
+    const uint64_t key = edge_key(now_.tri[t][i], now_.tri[t][(i + 1) % 3]);
+    auto it = cache_.find(key);
+    if (it == cache_.end()) it = cache_.emplace(key, split_point(t, i)).first;
+    return it->second;
+  }
+
+  // Chord area gained by splitting triangle t into four at its split points (known for all edges).
+  double split_gain(int t) const {
+    const auto& c = now_.tri[t];
+    Vec3 m[3];
+    for (int i = 0; i < 3; ++i) m[i] = cache_.at(edge_key(c[i], c[(i + 1) % 3])).image_xyz;
+    const Vec3 &y0 = now_.image_xyz[c[0]], &y1 = now_.image_xyz[c[1]], &y2 = now_.image_xyz[c[2]];
+    return triangle_area(y0, m[0], m[2]) + triangle_area(m[0], y1, m[1]) + triangle_area(m[2], m[1], y2) +
+           triangle_area(m[0], m[1], m[2]) - triangle_area(y0, y1, y2);
+  }
+
+  // Edge order for the longest-edge bisection: length, then vertex ids (a strict total order, so
+  // every propagation path ends).
+  bool longer(int a0, int b0, int a1, int b1) const {
+    const double l0 = (now_.position[a0] - now_.position[b0]).squaredNorm();
+    const double l1 = (now_.position[a1] - now_.position[b1]).squaredNorm();
+    if (l0 != l1) return l0 > l1;
+    return edge_key(a0, b0) > edge_key(a1, b1);
+  }
+
+  int longest_edge(int t) const {
+    const auto& c = now_.tri[t];
+    int best = 0;
+    for (int i = 1; i < 3; ++i)
+      if (longer(c[i], c[(i + 1) % 3], c[best], c[(best + 1) % 3])) best = i;
+    return best;
+  }
+
+  // Rivara's longest-edge bisection of triangle t: bisects terminal edges of t's longest-edge
+  // propagation path until t itself is bisected. Kept only if the triangles it split end with
+  // fewer bad ones (t bad) or no more (t good) than they had; otherwise undone, and t is not
+  // tried again until a neighbour's refinement changes it.
+  bool refine(int t, bool t_bad) {
+    journal_.clear();
+    const int base = static_cast<int>(now_.tri.size());
+    const int version = version_[t];
+    while (version_[t] == version) {
+      int current = t;
+      for (;;) {
+        const int i = longest_edge(current);
+        const int u = now_.adj[current][i];
+        const int j = longest_edge(u);
+        if (frozen_[now_.parent[current]] || frozen_[now_.parent[u]]) {
+          while (!journal_.empty()) undo_last();
+          failed_[t] = version_[t];
+          return false;
+        }
+        if (now_.tri[u][j] == now_.tri[current][(i + 1) % 3] && now_.tri[u][(j + 1) % 3] == now_.tri[current][i]) {
+          bisect(current, i);
+          break;
+        }
+        current = u;
+      }
+    }
+    std::unordered_map<int, char> before;  // pre-existing slots split: their state before
+    std::vector<int> touched;
+    for (const Undo& r : journal_) {
+      for (const auto& [slot, state] : {std::pair<int, char>{r.t, r.state_t}, std::pair<int, char>{r.u, r.state_u}})
+        if (slot < base) before.emplace(slot, state);
+      for (int slot : {r.t, r.u, r.t2, r.u2}) touched.push_back(slot);
+    }
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    int bad_before = 0, bad_after = 0;
+    for (const auto& [slot, state] : before) bad_before += state != 0;
+    for (int slot : touched) {
+      if (now_.state[slot] < 0) judge(slot);
+      bad_after += now_.state[slot] != 0;
+    }
+    if (t_bad ? bad_after < bad_before : bad_after <= bad_before) {
+      failed_.resize(now_.tri.size(), -1);
+      return true;
+    }
+    while (!journal_.empty()) undo_last();
+    failed_[t] = version_[t];
+    return false;
+  }
+
+  void judge(int t) {
+    const auto& c = now_.tri[t];
+    now_.state[t] = static_cast<char>(target_.judge(now_.image_xyz[c[0]], now_.image_xyz[c[1]], now_.image_xyz[c[2]],
+                                                    now_.image_face[c[0]], now_.image_face[c[1]], now_.image_face[c[2]]));
+  }
+
+  // Undoes the last bisection of the open transaction.
+  void undo_last() {
+    Sampling& s = now_;
+    const Undo r = journal_.back();
+    journal_.pop_back();
+    s.tri[r.t] = r.tri_t;
+    s.adj[r.t] = r.adj_t;
+    s.bary[r.t] = r.bary_t;
+    s.level[r.t] = r.level_t;
+    s.state[r.t] = r.state_t;
+    version_[r.t] = r.version_t;
+    s.tri[r.u] = r.tri_u;
+    s.adj[r.u] = r.adj_u;
+    s.bary[r.u] = r.bary_u;
+    s.level[r.u] = r.level_u;
+    s.state[r.u] = r.state_u;
+    version_[r.u] = r.version_u;
+    relink(r.n_bc, r.b, r.c, r.t);
+    relink(r.n_ad, r.a, r.d, r.u);
+    for (int k = 0; k < 2; ++k) {
+      s.tri.pop_back();
+      s.adj.pop_back();
+      s.bary.pop_back();
+      s.parent.pop_back();
+      s.level.pop_back();
+      s.state.pop_back();
+      version_.pop_back();
+    }
+    s.position.pop_back();
+    s.origin.pop_back();
+    s.image.pop_back();
+    s.image_xyz.pop_back();
+    s.image_face.pop_back();
+    s.image_distance.pop_back();
+    s.splits.pop_back();
+    --s.bisections;
+    cache_[edge_key(r.a, r.b)] = r.split;
+  }
+
+  // Sets the neighbour of triangle n across its edge (b, a) — the edge (a, b) of another — to t.
+  void relink(int n, int a, int b, int t) {
+    for (int k = 0; k < 3; ++k)
+      if (now_.tri[n][k] == b && now_.tri[n][(k + 1) % 3] == a) {
+        now_.adj[n][k] = t;
+        return;
+      }
+  }
+
+  // Splits edge i of triangle t (from corner i to i + 1) and the triangle across it.
+  void bisect(int t, int i) {
+    Sampling& s = now_;
+    const int a = s.tri[t][i], b = s.tri[t][(i + 1) % 3], c = s.tri[t][(i + 2) % 3];
+    const int u = s.adj[t][i];
+    int j = 0;
+    while (!(s.tri[u][j] == b && s.tri[u][(j + 1) % 3] == a)) ++j;
+    const int d = s.tri[u][(j + 2) % 3];
+    const SplitPoint p = cached_split(t, i);
+    cache_.erase(edge_key(a, b));
+    const double from_a = a < b ? p.s : 1 - p.s;
+
+    const int m = static_cast<int>(s.position.size());
+    s.position.push_back(p.position);
+    s.origin.push_back(p.origin);
+    s.image.push_back(p.image);
+    s.image_xyz.push_back(p.image_xyz);
+    const auto [face, distance] = target_.closest(p.image_xyz);
+    s.image_face.push_back(face);
+    s.image_distance.push_back(distance);
+    s.splits.emplace_back(edge_key(a, b), m);
+    ++s.bisections;
+
+    const std::array<Vec3, 3> bt = {s.bary[t][i], s.bary[t][(i + 1) % 3], s.bary[t][(i + 2) % 3]};  // a, b, c
+    const std::array<Vec3, 3> bu = {s.bary[u][j], s.bary[u][(j + 1) % 3], s.bary[u][(j + 2) % 3]};  // b, a, d
+    const Vec3 mt = (1 - from_a) * bt[0] + from_a * bt[1];
+    const Vec3 mu = (1 - from_a) * bu[1] + from_a * bu[0];
+    const int n_bc = s.adj[t][(i + 1) % 3], n_ca = s.adj[t][(i + 2) % 3];
+    const int n_ad = s.adj[u][(j + 1) % 3], n_db = s.adj[u][(j + 2) % 3];
+
+    const int t2 = static_cast<int>(s.tri.size()), u2 = t2 + 1;
+    journal_.push_back(Undo{t, u, t2, u2, n_bc, n_ad, a, b, c, d, s.tri[t], s.tri[u], s.adj[t], s.adj[u], s.bary[t], s.bary[u],
+                            s.level[t], s.level[u], s.state[t], s.state[u], version_[t], version_[u], p});
+    s.tri.resize(t2 + 2);
+    s.adj.resize(t2 + 2);
+    s.bary.resize(t2 + 2);
+    s.parent.push_back(s.parent[t]);
+    s.parent.push_back(s.parent[u]);
+    const int lt = s.level[t] + 1, lu = s.level[u] + 1;
+    s.level[t] = lt;
+    s.level[u] = lu;
+    s.level.push_back(lt);
+    s.level.push_back(lu);
+    s.state[t] = s.state[u] = -1;
+    s.state.push_back(-1);
+    s.state.push_back(-1);
+    version_[t]++;
+    version_[u]++;
+    version_.push_back(0);
+    version_.push_back(0);
+
+    // t = (a, m, c), t2 = (m, b, c), u = (b, m, d), u2 = (m, a, d).
+    s.tri[t] = {a, m, c};
+    s.bary[t] = {bt[0], mt, bt[2]};
+    s.tri[t2] = {m, b, c};
+    s.bary[t2] = {mt, bt[1], bt[2]};
+    s.tri[u] = {b, m, d};
+    s.bary[u] = {bu[0], mu, bu[2]};
+    s.tri[u2] = {m, a, d};
+    s.bary[u2] = {mu, bu[1], bu[2]};
+    s.adj[t] = {u2, t2, n_ca};
+    s.adj[t2] = {u, n_bc, t};
+    s.adj[u] = {t2, u2, n_db};
+    s.adj[u2] = {t, n_ad, u};
+    relink(n_bc, b, c, t2);
+    relink(n_ad, a, d, u2);
+  }
+
+  const TriMesh& model_;
+  Evaluator evaluate_;
+  const MapRefinementOptions& options_;
+  const AuditTarget target_;
+  std::vector<double> planes_;
+  const std::vector<char>& frozen_;
+  Sampling now_;
+  std::vector<int> version_;                        // per triangle slot: bumped when it is split
+  std::unordered_map<uint64_t, SplitPoint> cache_;  // per unsplit edge: its split point, once evaluated
+  std::vector<int> failed_;                         // per slot: its version when its refinement was undone
+  // One bisection of the open refinement: what it changed, to undo it.
+  struct Undo {
+    int t, u, t2, u2, n_bc, n_ad, a, b, c, d;
+    std::array<int, 3> tri_t, tri_u, adj_t, adj_u;
+    std::array<Vec3, 3> bary_t, bary_u;
+    int level_t, level_u;
+    char state_t, state_u;
+    int version_t, version_u;
+    SplitPoint split;
+  };
+  std::vector<Undo> journal_;
+};
+
+// The refined Polycube: the unrefined one with the sampling's mesh, per-triangle labels of the
+// parent triangles, and the new vertices on the polycube edges.
+Polycube refined_polycube(const Polycube& unrefined, const Sampling& s) {
+  Polycube out = unrefined;
+  const int nv = static_cast<int>(s.position.size()), nf = static_cast<int>(s.tri.size());
+  out.mesh.V.resize(nv, 3);
+  for (int v = 0; v < nv; ++v) out.mesh.V.row(v) = s.position[v].transpose();
+  out.mesh.F.resize(nf, 3);
+  out.face_axis.resize(nf);
+  out.face_patch.resize(nf);
+  for (int t = 0; t < nf; ++t) {
+    for (int i = 0; i < 3; ++i) out.mesh.F(t, i) = s.tri[t][i];
+    out.face_axis[t] = unrefined.face_axis[s.parent[t]];
+    out.face_patch[t] = unrefined.face_patch[s.parent[t]];
+  }
+  std::unordered_map<uint64_t, int> split_of(s.splits.begin(), s.splits.end());
+  out.spacing = 0;
+  for (PolycubeEdge& edge : out.edges) {
+    std::vector<int> vertices;
+    // Expands segment (a, b) into the vertices now on it, a excluded.
+    auto expand = [&](auto&& self, int a, int b) -> void {
+      const auto it = split_of.find(edge_key(a, b));
+      if (it == split_of.end()) {
+        vertices.push_back(b);
+        return;
+      }
+      self(self, a, it->second);
+      self(self, it->second, b);
+    };
+    vertices.push_back(edge.vertices.front());
+    for (size_t k = 0; k + 1 < edge.vertices.size(); ++k) expand(expand, edge.vertices[k], edge.vertices[k + 1]);
+    for (size_t k = 0; k + 1 < vertices.size(); ++k)
+      out.spacing = std::max(out.spacing, (s.position[vertices[k + 1]] - s.position[vertices[k]]).norm());
+    edge.vertices = std::move(vertices);
+  }
+  return out;
+}
+
+// φ⁻¹ at the model's vertices as points of the refined triangles: the refined triangle of the
+// same unrefined face that contains the point best, same position.
+std::vector<SurfacePoint> reexpress(const std::vector<SurfacePoint>& on_unrefined, const Sampling& s, int unrefined_faces) {
+  std::vector<std::vector<int>> children(unrefined_faces);
+  for (size_t t = 0; t < s.tri.size(); ++t) children[s.parent[t]].push_back(static_cast<int>(t));
+  std::vector<SurfacePoint> out(on_unrefined.size());
+  for (size_t w = 0; w < on_unrefined.size(); ++w) {
+    const SurfacePoint& p = on_unrefined[w];
+    double best = -INFINITY;
+    for (int t : children[p.face]) {
+      Eigen::Matrix3d B;
+      for (int i = 0; i < 3; ++i) B.col(i) = s.bary[t][i];
+      const Vec3 lambda = B.fullPivLu().solve(p.bary);
+      if (lambda.minCoeff() > best) {
+        best = lambda.minCoeff();
+        out[w].face = t;
+        out[w].bary = lambda;
+      }
+    }
+    Vec3& b = out[w].bary;
+    b = b.cwiseMax(0.0);
+    b /= b.sum();
+  }
+  return out;
+}
+
+}  // namespace
+
+namespace {
+
+// Attempts with more of P frozen when the refinement turns M → P triangles bad.
+constexpr int kModelToPolycubeAttempts = 3;
+
+TriMesh mesh_of(const Sampling& s) {
+  TriMesh mesh;
+  mesh.V.resize(static_cast<int>(s.position.size()), 3);
+  for (size_t v = 0; v < s.position.size(); ++v) mesh.V.row(static_cast<int>(v)) = s.position[v].transpose();
+  mesh.F.resize(static_cast<int>(s.tri.size()), 3);
+  for (size_t t = 0; t < s.tri.size(); ++t)
+    for (int i = 0; i < 3; ++i) mesh.F(static_cast<int>(t), i) = s.tri[t][i];
+  return mesh;
+}
+
+// Per triangle of `source` placed at `image`: bad (flipped or degenerate) as the audit judges it
+// against `target`.
+std::vector<char> verdicts(const AuditTarget& target, const TriMesh& source, const Eigen::MatrixX3d& image, int threads) {
+  std::vector<int> face(source.num_vertices());
+  parallel_range(source.num_vertices(), threads, [&](int v) { face[v] = target.closest(row(image, v)).first; });
+  std::vector<char> out(source.num_faces());
+  parallel_range(source.num_faces(), threads, [&](int f) {
+    out[f] = target.judge(row(image, source.F(f, 0)), row(image, source.F(f, 1)), row(image, source.F(f, 2)), face[source.F(f, 0)],
+                          face[source.F(f, 1)], face[source.F(f, 2)]) != 0;
+  });
+  return out;
+}
+
+// Both entry points: checks, then rounds of refinement of `polycube` sampling `evaluate`, whose
+// values at P's vertices are `map`'s.
+MapRefinementResult refine_sampling(const char* name, const TriMesh& model, const Polycube& polycube, const std::vector<double>& planes,
+                                    const PolycubeMap& map, const Evaluator& evaluate, const MapRefinementOptions& options) {
+  const auto start = Clock::now();
+  const TriMesh& P = polycube.mesh;
+  const std::string fn = std::string(name) + ": ";
+  if (static_cast<int>(map.polycube_on_model.size()) != P.num_vertices() || static_cast<int>(map.model_on_polycube.size()) != model.num_vertices() ||
+      map.polycube_on_model_xyz.rows() != P.num_vertices() || map.model_on_polycube_xyz.rows() != model.num_vertices())
+    throw std::invalid_argument(fn + "the map has " + std::to_string(map.polycube_on_model.size()) + " / " +
+                                std::to_string(map.model_on_polycube.size()) + " images, the meshes " + std::to_string(P.num_vertices()) +
+                                " / " + std::to_string(model.num_vertices()) + " vertices");
+  for (const SurfacePoint& p : map.polycube_on_model)
+    if (p.face < 0 || p.face >= model.num_faces())
+      throw std::invalid_argument(fn + "an image on the model has face " + std::to_string(p.face));
+  for (const SurfacePoint& p : map.model_on_polycube)
+    if (p.face < 0 || p.face >= P.num_faces())
+      throw std::invalid_argument(fn + "an image on the polycube has face " + std::to_string(p.face));
+  if (!(options.area_tolerance >= 0) || !(options.max_vertex_factor >= 1) || options.min_vertex_budget < 0 || options.max_rounds < 0 ||
+      options.max_level < 0)
+    throw std::invalid_argument(fn + "need area_tolerance >= 0, max_vertex_factor >= 1, min_vertex_budget >= 0, "
+                                "max_rounds >= 0, max_level >= 0; got " + std::to_string(options.area_tolerance) + ", " +
+                                std::to_string(options.max_vertex_factor) + ", " + std::to_string(options.min_vertex_budget) + ", " +
+                                std::to_string(options.max_rounds) + ", " + std::to_string(options.max_level));
+
+  MapRefinementResult result;
+  result.vertices_before = P.num_vertices();
+  result.triangles_before = P.num_faces();
+  auto bad = [](const MapDirectionAudit& a) { return a.flipped + a.degenerate; };
+  // Fewest bad triangles first, then the area's distance beyond the tolerance, then fewer vertices.
+  auto score = [&](const std::pair<int, double>& m) {
+    const double ratio = m.second / surface_area(model);
+    return std::make_pair(m.first, std::max(0.0, std::abs(ratio - 1) - options.area_tolerance));
+  };
+  const int max_vertices = static_cast<int>(std::max(options.max_vertex_factor * P.num_vertices(),
+                                                     static_cast<double>(P.num_vertices()) + options.min_vertex_budget));
+  // The M → P samples keep their positions, but the audit judges their chords against the P
+  // triangles closest to them (area-weighted normals), which the refinement changes: a chord
+  // whose normal is positive against one nearby P face and negative against another can change
+  // its verdict. Where M → P triangles turn bad, the unrefined faces closest to them (and their
+  // neighbours) are frozen and the refinement runs again, a few times at most.
+  std::vector<char> frozen(P.num_faces(), 0);
+  std::vector<std::vector<int>> faces_at(P.num_vertices());
+  for (int f = 0; f < P.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) faces_at[P.F(f, i)].push_back(f);
+  // The input's M → P verdicts, computed when first needed.
+  std::vector<char> base_verdict;
+  int m_input = 0;
+  auto input_verdicts = [&]() {
+    if (!base_verdict.empty()) return;
+    const AuditTarget base_target(P);
+    base_verdict = verdicts(base_target, model, map.model_on_polycube_xyz, options.threads);
+    m_input = static_cast<int>(std::count(base_verdict.begin(), base_verdict.end(), 1));
+  };
+  int p_input = 0;
+  // The best attempt: admissible (P → M no worse; M → P no worse or both together fewer), then
+  // fewest bad triangles of both directions, then the area nearest the tolerance.
+  Sampling best;
+  bool improved = false;
+  std::tuple<int, double, int> best_key{0, 0.0, 0};  // (P → M + M → P bad, area excess, P → M bad)
+  for (int attempt = 0;; ++attempt) {
+    Refiner refiner(model, polycube, planes, map, evaluate, frozen, options);
+    if (attempt == 0) {
+      result.before = refiner.audit();
+      p_input = bad(result.before);
+    }
+    const std::pair<int, double> refiner_start = refiner.measure();
+    auto attempt_score = score(refiner_start);
+    Sampling attempt_best;
+    bool attempt_improved = false;
+    int rounds = 0;
+    while (rounds < options.max_rounds && (attempt_score.first > 0 || attempt_score.second > 0)) {
+      if (static_cast<int>(refiner.sampling().position.size()) >= max_vertices) break;
+      if (!refiner.round(max_vertices)) break;
+      ++rounds;
+      const auto now = score(refiner.measure());
+      if (now < attempt_score) {
+        attempt_score = now;
+        attempt_best = refiner.sampling();
+        attempt_improved = true;
+      }
+    }
+    result.rounds += rounds;
+    if (!attempt_improved) break;
+    if (attempt == 0) {
+      input_verdicts();
+      const auto start_score = score(refiner_start);
+      best_key = {p_input + m_input, start_score.second, p_input};
+    }
+    // M → P verdicts per model triangle against the refined P.
+    const TriMesh refined = mesh_of(attempt_best);
+    const AuditTarget refined_target(refined);
+    const std::vector<char> verdict = verdicts(refined_target, model, map.model_on_polycube_xyz, options.threads);
+    const int m_bad = static_cast<int>(std::count(verdict.begin(), verdict.end(), 1));
+    const int p_bad = attempt_score.first;
+    const std::tuple<int, double, int> key{p_bad + m_bad, attempt_score.second, p_bad};
+    int frozen_now = 0;
+    for (int f = 0; f < model.num_faces(); ++f) {
+      if (!verdict[f] || base_verdict[f]) continue;
+      const Vec3 a = row(map.model_on_polycube_xyz, model.F(f, 0)), b = row(map.model_on_polycube_xyz, model.F(f, 1)),
+                 c = row(map.model_on_polycube_xyz, model.F(f, 2));
+      for (const Vec3& x : {a, b, c, Vec3((a + b + c) / 3)}) {
+        const int parent = attempt_best.parent[refined_target.closest(x).first];
+        for (int i = 0; i < 3; ++i)
+          for (int g : faces_at[P.F(parent, i)]) frozen_now += !frozen[g], frozen[g] = 1;
+      }
+    }
+    if (p_bad <= p_input && (m_bad <= m_input || p_bad + m_bad < p_input + m_input) && key < best_key) {
+      best_key = key;
+      best = std::move(attempt_best);
+      improved = true;
+    }
+    if (frozen_now == 0 || attempt == kModelToPolycubeAttempts) break;
+    result.frozen_faces += frozen_now;
+  }
+
+  result.polycube_origin.resize(P.num_vertices());
+  if (improved) {
+    // Kept only if P → M got no worse and either M → P got no worse or both directions together
+    // have fewer bad triangles, judged by the audit itself.
+    result.model_to_polycube_before = audit_map_direction(model, map.model_on_polycube_xyz, P);
+    result.model_to_polycube_after = audit_map_direction(model, map.model_on_polycube_xyz, mesh_of(best));
+    const int p_before = bad(result.before), p_after = std::get<2>(best_key);
+    const int m_before = bad(result.model_to_polycube_before), m_after = bad(result.model_to_polycube_after);
+    if (!(p_after <= p_before && (p_after + m_after < p_before + m_before || m_after <= m_before))) {
+      improved = false;
+      result.model_to_polycube_rejected = true;
+    }
+  }
+  if (!improved) {
+    // Unchanged: the input sampling.
+    result.polycube = polycube;
+    result.map = map;
+    result.map.data.reset();
+    for (int f = 0; f < P.num_faces(); ++f)
+      for (int i = 0; i < 3; ++i) result.polycube_origin[P.F(f, i)] = SurfacePoint{f, Vec3::Unit(i)};
+    result.face_origin = Eigen::VectorXi::LinSpaced(P.num_faces(), 0, P.num_faces() - 1);
+    result.after = result.before;
+    result.model_to_polycube_after = result.model_to_polycube_before;
+  } else {
+    Sampling& s = best;
+    result.refined = true;
+    result.bisections = s.bisections;
+    result.polycube = refined_polycube(polycube, s);
+    result.polycube_origin = s.origin;
+    result.face_origin.resize(static_cast<int>(s.parent.size()));
+    for (size_t t = 0; t < s.parent.size(); ++t) result.face_origin[static_cast<int>(t)] = s.parent[t];
+    PolycubeMap& out = result.map;
+    out.polycube_on_model = s.image;
+    out.polycube_on_model_xyz.resize(static_cast<int>(s.image_xyz.size()), 3);
+    for (size_t v = 0; v < s.image_xyz.size(); ++v) out.polycube_on_model_xyz.row(static_cast<int>(v)) = s.image_xyz[v].transpose();
+    out.model_on_polycube = reexpress(map.model_on_polycube, s, P.num_faces());
+    out.model_on_polycube_xyz = map.model_on_polycube_xyz;
+    out.pieces = map.pieces;
+    out.contours = map.contours;
+    out.seconds = map.seconds;
+    result.after = audit_map_direction(result.polycube.mesh, out.polycube_on_model_xyz, model);
+  }
+  result.vertices_after = result.polycube.mesh.num_vertices();
+  result.triangles_after = result.polycube.mesh.num_faces();
+  result.converged = result.after.flipped == 0 && result.after.degenerate == 0 &&
+                     std::abs(result.after.area_ratio - 1) <= options.area_tolerance;
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
+}  // namespace
+
+MapRefinementResult refine_map_sampling(const TriMesh& model, const PolycubeResult& polycube, const PolycubeMap& map,
+                                        const MapRefinementOptions& options) {
+  if (!map.data) throw std::invalid_argument("refine_map_sampling: the map has no data to evaluate φ with");
+  return refine_sampling("refine_map_sampling", model, polycube.polycube, polycube.planes_z, map,
+                         [&map](const SurfacePoint& p) { return map.to_model(p); }, options);
+}
+
+MapRefinementResult refine_vertex_map_sampling(const TriMesh& model, const Polycube& polycube, const std::vector<double>& planes_z,
+                                               const PolycubeMap& samples, const MapRefinementOptions& options) {
+  if (samples.polycube_on_model_xyz.rows() != polycube.mesh.num_vertices())
+    throw std::invalid_argument("refine_vertex_map_sampling: " + std::to_string(samples.polycube_on_model_xyz.rows()) +
+                                " images for " + std::to_string(polycube.mesh.num_vertices()) + " vertices");
+  const AuditTarget surface(model);
+  const TriMesh& P = polycube.mesh;
+  const Eigen::MatrixX3d& Y = samples.polycube_on_model_xyz;
+  auto evaluate = [&](const SurfacePoint& p) {
+    const Vec3 chord = p.bary[0] * row(Y, P.F(p.face, 0)) + p.bary[1] * row(Y, P.F(p.face, 1)) + p.bary[2] * row(Y, P.F(p.face, 2));
+    return surface.closest_point(model, chord);
+  };
+  MapRefinementResult result = refine_sampling("refine_vertex_map_sampling", model, polycube, planes_z, samples, evaluate, options);
+  result.map.pieces = samples.pieces;
+  return result;
+}
+
+}  // namespace polycube
