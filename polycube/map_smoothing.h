@@ -51,9 +51,8 @@
 //      its fan (the neighbours' images projected) is largest, taken only if it leaves fewer bad
 //      triangles round the vertex and turns no good one bad. The M-side phase is first run
 //      letting P → M get worse (the P-side phase then repairs it), and if that pair does not pay,
-//      with neither direction allowed to get worse. Each pass tries 0, 1, r, 2r, 3r + 1 and 5r
-//      rings round the flipped triangles (r = untangle_rings; which is best differs from mesh to
-//      mesh) and keeps the outcome with the fewest flips, then the fewest M → P flips; a pass is kept
+//      with neither direction allowed to get worse. The vertices within r rings of the flipped
+//      triangles move (r = untangle_rings); a pass is kept
 //      only if it leaves neither direction worse and lowers the flips in all, so the untangling
 //      never adds a flip.
 //      Diagnosis behind it (dev meshes; scratch tools, default parameters): the M → P flips that
@@ -94,8 +93,8 @@ struct MapSmoothingOptions {
   // neighbours' average (then 1, ½, ¼ if that spoils a triangle). 1.5 roughly halves the sweeps
   // needed for the same angle distortion on the paper's models.
   double relaxation = 1.5;
-  // The untangling (step 4 at the top): the base number r of edges round a flipped triangle
-  // within which vertices may move (each pass tries 0, 1, r, 2r, 3r + 1 and 5r); 0: no untangling.
+  // The untangling (step 4 at the top): the number r of edges round a flipped triangle within
+  // which vertices may move; 0: no untangling.
   int untangle_rings = 3;
 };
 
