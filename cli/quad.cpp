@@ -35,6 +35,7 @@ struct QuadCommandOptions {
   double cell_size = 0;
   std::string map_dir;
   int smooth = 60;
+  bool fit = true;
   std::string report_path;
   std::string preview_path;
   std::string align = "auto";
@@ -156,7 +157,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                           {"cell_size", options.cell_size > 0 ? nlohmann::json(options.cell_size) : nlohmann::json()},
                           {"smooth", options.smooth},
                           {"map", options.map_dir.empty() ? nlohmann::json() : nlohmann::json(options.map_dir)}};
-  nlohmann::json seconds;
+  nlohmann::json seconds = {{"read", progress.elapsed_seconds()}};
 
   // The map P → M: from the directory, or built now.
   const TriMesh* polycube_mesh = nullptr;
@@ -185,7 +186,9 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       progress.stage("align", options.align == "auto"
                                   ? "6 orientations (input frame, principal axes): polycubes, then maps of the 3 with fewest corners, scored by flips"
                                   : "6 orientations (input frame, principal axes): the polycube with the fewest corners");
+      const double align_start = progress.elapsed_seconds();
       alignment = choose_alignment(model, options.topology, options.polycube, align_options);
+      seconds["align"] = progress.elapsed_seconds() - align_start;
       if (alignment.chosen >= 0) {
         rotation = alignment.rotation;
         progress.stage("align", alignment.candidates[alignment.chosen].name);
@@ -226,6 +229,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   remesh.grid.cell_size = options.cell_size;
   remesh.grid.target_quads = options.target_faces;
   remesh.smooth.sweeps = options.smooth;
+  if (!options.fit) remesh.fit.passes = 0;
   const QuadRemeshResult result =
       remesh_quads(*polycube_mesh, to_model, *projector, remesh,
                    [&progress](const std::string& stage, const std::string& message) { progress.stage(stage, message); });
@@ -256,6 +260,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   seconds["grid"] = result.seconds_grid;
   seconds["carry"] = result.seconds_carry;
   seconds["smooth"] = result.seconds_smooth;
+  seconds["fit"] = result.seconds_fit;
   seconds["quality"] = result.seconds_quality;
   seconds["total"] = progress.elapsed_seconds();
   progress.stage("done", "wrote " + options.output);
@@ -287,6 +292,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                       {"chords", grid.chords}};
     report["smoothing"] = {{"sweeps", result.smoothing.sweeps}, {"moves", result.smoothing.moves}, {"refused", result.smoothing.rejected},
                            {"converged", result.smoothing.converged}, {"largest_move", result.smoothing.largest_move}};
+    report["fitting"] = {{"passes", result.fitting.passes},
+                         {"snapped", result.fitting.snapped},
+                         {"farthest_before", result.fitting.farthest_before},
+                         {"farthest_after", result.fitting.farthest_after},
+                         {"relaxation_sweeps", result.refitting.sweeps}};
     report["quality"] = quality_json(q);
     report["warnings"] = warnings;
     report["seconds"] = seconds;
@@ -321,6 +331,8 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
   command->add_option("--smooth", options->smooth, "Relaxation sweeps on the model at most, towards right angles and even sizes (stops when converged; never flips a quad; 0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0, 10000));
+  command->add_flag("--no-fit{false}", options->fit,
+                   "Do not pull quad corners onto the model's tips and edges the quads miss (the fit, after the relaxation)");
   command->add_option("--report", options->report_path, "Write the quality report as JSON to this file");
   command->add_option("--preview", options->preview_path, "Write a picture of the quads (PNG), front and back");
   command->add_option("--smooth-sweeps", options->smooth_map_sweeps, "Sweeps of the map smoothing before carrying the grid (as `map --smooth-sweeps`; 0: the unsmoothed map; not with --map)")

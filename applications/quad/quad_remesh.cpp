@@ -1,5 +1,6 @@
 #include "applications/quad/quad_remesh.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -48,6 +49,24 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     report("smooth", std::to_string(result.smoothing.sweeps) + " sweeps" + (result.smoothing.converged ? " (converged), " : ", ") +
                          std::to_string(result.smoothing.moves) + " moves, " + std::to_string(result.smoothing.rejected) +
                          " refused (would flip a quad or leave the surface under the vertex)");
+  }
+
+  if (options.fit.passes > 0) {
+    report("fit", "corners pulled onto the model's vertices the quads miss");
+    start = std::chrono::steady_clock::now();
+    result.fitting = fit_quads(result.mesh, model, options.fit);
+    result.mesh = result.fitting.mesh;
+    result.fitting.mesh = QuadMesh{};
+    if (result.fitting.snapped > 0 && options.smooth.sweeps > 0 && options.refit_sweeps > 0) {
+      QuadSmoothOptions again = options.smooth;
+      again.sweeps = std::min(options.refit_sweeps, options.smooth.sweeps);
+      result.refitting = smooth_quads(result.mesh, model, again, result.fitting.pinned);
+      result.mesh = std::move(result.refitting.mesh);
+      result.refitting.mesh = QuadMesh{};
+    }
+    result.seconds_fit = since(start);
+    report("fit", std::to_string(result.fitting.snapped) + " corners pulled, farthest model vertex " +
+                      format("%.4g -> %.4g from the quads", result.fitting.farthest_before, result.fitting.farthest_after));
   }
 
   if (options.measure) {

@@ -5,6 +5,8 @@
 //                                               chords sized by their length on M
 //   quads   = carry_grid(grid, map)             the same quads on M
 //   quads   = smooth_quads(quads, M)            optional: towards right angles, never flips a quad
+//   quads   = fit_quads(quads, M)               optional: corners pulled onto the model's tips,
+//                                               then relaxed again around them (pinned)
 //   quality = measure_quads(quads, M, corners)
 #pragma once
 
@@ -20,7 +22,7 @@
 namespace polycube {
 
 // Called when a step starts and when it ends: (stage, message). Stages: "grid", "carry",
-// "smooth", "quality".
+// "smooth", "fit", "quality".
 using QuadProgress = std::function<void(const std::string& stage, const std::string& message)>;
 
 struct QuadRemeshOptions {
@@ -30,6 +32,10 @@ struct QuadRemeshOptions {
   bool size_on_model = true;
   CarryOptions carry;
   QuadSmoothOptions smooth;
+  // The fit to the model's extremities after the relaxation (passes 0: none), then this many
+  // relaxation sweeps with the pulled vertices pinned (at most smooth.sweeps).
+  QuadFitOptions fit;
+  int refit_sweeps = 10;
   QuadQualityOptions quality;
   bool measure = true;  // false: skip measure_quads
 };
@@ -38,16 +44,21 @@ struct QuadRemeshOptions {
 //   grid       the grid on P (positions on P, vertices as points of P, corners)
 //   mesh       the quads on M (grid's connectivity)
 //   smoothing  what the relaxation did (nothing when options.smooth.sweeps is 0)
+//   fitting    what the fit did (its mesh left empty; nothing when options.fit.passes is 0)
+//   refitting  the relaxation after the fit, pulled vertices pinned (its mesh left empty)
 //   quality    of mesh against M (quality.seconds: its time)
 //   seconds_*  wall time per stage
 struct QuadRemeshResult {
   PolycubeGrid grid;
   QuadMesh mesh;
   QuadSmoothResult smoothing;
+  QuadFitResult fitting;
+  QuadSmoothResult refitting;
   QuadQuality quality;
   double seconds_grid = 0;
   double seconds_carry = 0;
   double seconds_smooth = 0;
+  double seconds_fit = 0;
   double seconds_quality = 0;
 };
 

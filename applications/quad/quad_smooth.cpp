@@ -2,6 +2,8 @@
 
 #include "applications/quad/quad_quality.h"
 
+#include "polycube/parallel.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -9,8 +11,10 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -42,9 +46,68 @@ double mean_quad_size(const QuadMesh& mesh) {
   return std::sqrt(area / mesh.num_quads());
 }
 
+// Greedy colouring of the movable vertices such that two vertices of one colour share no quad.
+std::vector<std::vector<int>> quad_star_colours(const Eigen::MatrixX4i& Q, const std::vector<std::vector<int>>& around,
+                                                const std::vector<char>& pinned) {
+  const int nv = static_cast<int>(around.size());
+  std::vector<int> colour(nv, -1), seen;
+  std::vector<std::vector<int>> colours;
+  for (int v = 0; v < nv; ++v) {
+    if (around[v].empty() || (!pinned.empty() && pinned[v])) continue;
+    for (int q : around[v])
+      for (int k = 0; k < 4; ++k) {
+        const int c = colour[Q(q, k)];
+        if (c >= 0) seen[c] = v + 1;
+      }
+    int c = 0;
+    while (c < static_cast<int>(colours.size()) && seen[c] == v + 1) ++c;
+    if (c == static_cast<int>(colours.size())) {
+      colours.emplace_back();
+      seen.push_back(0);
+    }
+    colour[v] = c;
+    colours[c].push_back(v);
+  }
+  return colours;
+}
+
+// What the moves of a vertex may not spoil, per quad: bit k is set when corner k turns with the
+// quad's surface normal (as measure_quads counts inverted corners), bit 4 when the quad (its
+// diagonals) does (flipped quads). A move is refused when it clears a bit of one of the vertex's
+// quads.
+class QuadGuard {
+ public:
+  QuadGuard(const QuadMesh& mesh, const SurfaceProjector& surface) : mesh_(mesh), surface_(surface) {}
+
+  // centre: in, the search hint for the quad centre's closest point (face -1: none); out, that
+  // point. size: the mean quad size (corners with an edge below kCollapsedEdge of it are free).
+  int state(int q, SurfaceHit& centre, double size) const {
+    int bits = 0;
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = mesh_.V.row(mesh_.Q(q, k));
+    const Eigen::Vector3d middle = (p[0] + p[1] + p[2] + p[3]) / 4;
+    centre = centre.face >= 0 ? surface_.closest(middle, centre) : surface_.closest(middle);
+    const Eigen::Vector3d n = quad_surface_normal(surface_, centre);
+    // A corner with an edge of (almost) no length has no meaningful turn: it is not held, so
+    // vertices a map collapsed onto one point can move apart.
+    const double shortest = kCollapsedEdge * size;
+    for (int k = 0; k < 4; ++k)
+      if ((p[(k + 1) % 4] - p[k]).norm() > shortest && (p[(k + 3) % 4] - p[k]).norm() > shortest &&
+          (p[(k + 1) % 4] - p[k]).cross(p[(k + 3) % 4] - p[k]).dot(n) > 0)
+        bits |= 1 << k;
+    if ((p[2] - p[0]).cross(p[3] - p[1]).dot(n) > 0) bits |= 16;
+    return bits;
+  }
+
+ private:
+  const QuadMesh& mesh_;
+  const SurfaceProjector& surface_;
+};
+
 }  // namespace
 
-QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadSmoothOptions& options) {
+QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadSmoothOptions& options,
+                              const std::vector<char>& pinned) {
   const auto start = std::chrono::steady_clock::now();
   if (options.sweeps < 0) throw std::invalid_argument("smoothing sweeps must be >= 0, got " + std::to_string(options.sweeps));
   if (!(options.step > 0 && options.step <= 1))
@@ -55,6 +118,9 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
                                 std::to_string(wa) + ", " + std::to_string(wc));
   if (!(options.tolerance >= 0))
     throw std::invalid_argument("smoothing tolerance must be >= 0, got " + std::to_string(options.tolerance));
+  if (!pinned.empty() && static_cast<int>(pinned.size()) != quads.num_vertices())
+    throw std::invalid_argument("smoothing: " + std::to_string(pinned.size()) + " pinned flags for " + std::to_string(quads.num_vertices()) +
+                                " vertices");
   QuadSmoothResult result;
   result.mesh = quads;
   if (options.sweeps == 0) return result;
@@ -71,33 +137,23 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   std::vector<SurfaceHit> quad_hit(mesh.num_quads());
   double size = mean_quad_size(mesh);
 
-  // Bit k: corner k turns with the quad's surface normal (as measure_quads counts inverted
-  // corners); bit 4: the quad (diagonals) does (flipped quads). centre: in, the hint (face -1:
-  // none); out, the centre's closest point.
-  const auto state = [&](int q, SurfaceHit& centre) {
-    int bits = 0;
-    Eigen::Vector3d p[4];
-    for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
-    const Eigen::Vector3d middle = (p[0] + p[1] + p[2] + p[3]) / 4;
-    centre = centre.face >= 0 ? surface.closest(middle, centre) : surface.closest(middle);
-    const Eigen::Vector3d n = quad_surface_normal(surface, centre);
-    // A corner with an edge of (almost) no length has no meaningful turn: it is not held, so
-    // vertices a map collapsed onto one point can move apart.
-    const double shortest = kCollapsedEdge * size;
-    for (int k = 0; k < 4; ++k)
-      if ((p[(k + 1) % 4] - p[k]).norm() > shortest && (p[(k + 3) % 4] - p[k]).norm() > shortest &&
-          (p[(k + 1) % 4] - p[k]).cross(p[(k + 3) % 4] - p[k]).dot(n) > 0)
-        bits |= 1 << k;
-    if ((p[2] - p[0]).cross(p[3] - p[1]).dot(n) > 0) bits |= 16;
-    return bits;
-  };
+  const QuadGuard guard(mesh, surface);
+  const auto state = [&](int q, SurfaceHit& centre) { return guard.state(q, centre, size); };
 
   // The cross at v: its spokes (edges to its neighbours, counter-clockwise in the tangent plane
   // t1, t2 = n × t1) turned to equal angles (90° at a regular vertex) by the best common
   // rotation, each keeping its length; v goes where those spokes would start from.
-  std::vector<int> ring;
-  std::vector<Complex> spoke;
-  const auto cross_target = [&](int v, const Eigen::Vector3d& p, const Eigen::Vector3d& n) -> Eigen::Vector3d {
+  // Work space of one thread's moves.
+  struct Scratch {
+    std::vector<int> ring;
+    std::vector<Complex> spoke;
+    std::vector<std::pair<int, int>> rails;
+    std::vector<int> after;
+    std::vector<SurfaceHit> after_hit;
+  };
+  const auto cross_target = [&](int v, const Eigen::Vector3d& p, const Eigen::Vector3d& n, Scratch& scratch) -> Eigen::Vector3d {
+    std::vector<int>& ring = scratch.ring;
+    std::vector<Complex>& spoke = scratch.spoke;
     const Eigen::Vector3d nan = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
     const int k = static_cast<int>(around[v].size());
     if (k < 3) return nan;
@@ -139,109 +195,145 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
     return p + offset.real() * t1 + offset.imag() * t2;
   };
 
-  std::vector<int> quad_state(mesh.num_quads()), after;
-  std::vector<SurfaceHit> after_hit;
+  std::vector<int> quad_state(mesh.num_quads());
   for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = state(q, quad_hit[q]);
-  std::vector<std::pair<int, int>> rails;
+
+  // One Gauss–Seidel move of v; returns how far it moved (-1: refused, 0: nothing to do). Reads
+  // the vertices of v's quads, writes v and v's quads' states.
+  const auto move = [&](int v, Scratch& scratch) -> double {
+    std::vector<std::pair<int, int>>& rails = scratch.rails;
+    std::vector<int>& after = scratch.after;
+    std::vector<SurfaceHit>& after_hit = scratch.after_hit;
+    const Eigen::Vector3d p = mesh.V.row(v), n = vertex_hit[v].normal;
+    const SurfaceHit old_hit = vertex_hit[v];
+    Eigen::Vector3d average = Eigen::Vector3d::Zero();
+    for (int u : neighbours[v]) average += mesh.V.row(u).transpose();
+    average /= static_cast<double>(neighbours[v].size());
+    Eigen::Vector3d target = wl * average;
+    double weight = wl;
+    if (wc > 0) {
+      const Eigen::Vector3d c = cross_target(v, p, n, scratch);
+      if (c.allFinite()) {
+        target += wc * c;
+        weight += wc;
+      }
+    }
+    if (wa > 0) {
+      // Each spoke (v, a) lies in two of v's quads; the rails at a run to their corners
+      // opposite v.
+      rails.clear();
+      for (int q : around[v]) {
+        int k = 0;
+        while (mesh.Q(q, k) != v) ++k;
+        const int c = mesh.Q(q, (k + 2) % 4);
+        rails.emplace_back(mesh.Q(q, (k + 1) % 4), c);
+        rails.emplace_back(mesh.Q(q, (k + 3) % 4), c);
+      }
+      std::sort(rails.begin(), rails.end());
+      Eigen::Vector3d angles = Eigen::Vector3d::Zero();
+      int spokes = 0;
+      for (size_t r = 0; r + 1 < rails.size(); r += 2) {
+        if (rails[r].first != rails[r + 1].first) {  // not a closed fan: keep the average
+          spokes = 0;
+          break;
+        }
+        const Eigen::Vector3d a = mesh.V.row(rails[r].first);
+        const Eigen::Vector3d u1 = (mesh.V.row(rails[r].second).transpose() - a).normalized();
+        const Eigen::Vector3d u2 = (mesh.V.row(rails[r + 1].second).transpose() - a).normalized();
+        Eigen::Vector3d bisector = vertex_hit[rails[r].first].normal.cross(u2 - u1);
+        const double length = (p - a).norm();
+        if (!(bisector.norm() > 1e-12) || !(length > 0)) continue;
+        bisector.normalize();
+        if (bisector.dot(p - a) < 0) bisector = -bisector;
+        angles += a + length * bisector;
+        ++spokes;
+      }
+      if (spokes > 0) {
+        target += wa * angles / spokes;
+        weight += wa;
+      }
+    }
+    if (!(weight > 0)) return 0;
+    target /= weight;
+    Eigen::Vector3d d = target - p;
+    d -= d.dot(n) * n;
+    if (!d.allFinite() || d.squaredNorm() == 0) return 0;
+    for (double step = options.step; step >= options.step / 4; step /= 2) {
+      const SurfaceHit hit = surface.closest(p + step * d, old_hit);
+      // The closest point must be the surface under the vertex, not another sheet of a thin
+      // part (the far side of an ear) that happens to be nearer to the moved point.
+      if (!(hit.normal.dot(n) > kSameSheet) || (hit.point - p).norm() > 2 * step * d.norm()) continue;
+      // Nor may an edge shrink to almost nothing: near a convex corner of the surface, a whole
+      // cone of space has the corner as closest point, and vertices moved into it would merge
+      // into degenerate quads.
+      bool collapses = false;
+      for (int u : neighbours[v]) {
+        const double before = (mesh.V.row(u).transpose() - p).norm();
+        const double now = (mesh.V.row(u).transpose() - hit.point).norm();
+        collapses |= now < before && now < kShortestEdge * size;
+      }
+      if (collapses) continue;
+      mesh.V.row(v) = hit.point;
+      bool accepted = true;
+      after.clear();
+      after_hit.clear();
+      for (size_t k = 0; k < around[v].size() && accepted; ++k) {
+        after_hit.push_back(quad_hit[around[v][k]]);
+        after.push_back(state(around[v][k], after_hit.back()));
+        accepted = (quad_state[around[v][k]] & ~after.back()) == 0;
+      }
+      if (!accepted) continue;
+      vertex_hit[v] = hit;
+      for (size_t k = 0; k < around[v].size(); ++k) {
+        quad_state[around[v][k]] = after[k];
+        quad_hit[around[v][k]] = after_hit[k];
+      }
+      return (hit.point - p).norm();
+    }
+    mesh.V.row(v) = p;
+    return -1;
+  };
+
+  // Vertices sharing no quad move independently (a move reads and writes only its vertex's
+  // quads): colour by colour, each colour split over the threads. The result does not depend on
+  // the number of threads.
+  const std::vector<std::vector<int>> colours = quad_star_colours(mesh.Q, around, pinned);
+  const int threads = std::max(1, options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
+  std::vector<Scratch> scratch(threads);
+  struct Tally {
+    long long moves = 0, rejected = 0;
+    double largest = 0;
+  };
+  std::vector<int> parts(threads);
+  std::iota(parts.begin(), parts.end(), 0);
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     ++result.sweeps;
     size = mean_quad_size(mesh);
-    double largest = 0;
-    for (int v = 0; v < nv; ++v) {
-      if (neighbours[v].empty()) continue;
-      const Eigen::Vector3d p = mesh.V.row(v), n = vertex_hit[v].normal;
-      const SurfaceHit old_hit = vertex_hit[v];
-      Eigen::Vector3d average = Eigen::Vector3d::Zero();
-      for (int u : neighbours[v]) average += mesh.V.row(u).transpose();
-      average /= static_cast<double>(neighbours[v].size());
-      Eigen::Vector3d target = wl * average;
-      double weight = wl;
-      if (wc > 0) {
-        const Eigen::Vector3d c = cross_target(v, p, n);
-        if (c.allFinite()) {
-          target += wc * c;
-          weight += wc;
-        }
-      }
-      if (wa > 0) {
-        // Each spoke (v, a) lies in two of v's quads; the rails at a run to their corners
-        // opposite v.
-        rails.clear();
-        for (int q : around[v]) {
-          int k = 0;
-          while (mesh.Q(q, k) != v) ++k;
-          const int c = mesh.Q(q, (k + 2) % 4);
-          rails.emplace_back(mesh.Q(q, (k + 1) % 4), c);
-          rails.emplace_back(mesh.Q(q, (k + 3) % 4), c);
-        }
-        std::sort(rails.begin(), rails.end());
-        Eigen::Vector3d angles = Eigen::Vector3d::Zero();
-        int spokes = 0;
-        for (size_t r = 0; r + 1 < rails.size(); r += 2) {
-          if (rails[r].first != rails[r + 1].first) {  // not a closed fan: keep the average
-            spokes = 0;
-            break;
+    std::vector<Tally> tally(threads);
+    for (const std::vector<int>& colour : colours) {
+      const auto run = [&](int part) {
+        const size_t begin = colour.size() * part / threads, end = colour.size() * (part + 1) / threads;
+        for (size_t k = begin; k < end; ++k) {
+          const double moved = move(colour[k], scratch[part]);
+          if (moved > 0) {
+            ++tally[part].moves;
+            tally[part].largest = std::max(tally[part].largest, moved);
+          } else if (moved < 0) {
+            ++tally[part].rejected;
           }
-          const Eigen::Vector3d a = mesh.V.row(rails[r].first);
-          const Eigen::Vector3d u1 = (mesh.V.row(rails[r].second).transpose() - a).normalized();
-          const Eigen::Vector3d u2 = (mesh.V.row(rails[r + 1].second).transpose() - a).normalized();
-          Eigen::Vector3d bisector = vertex_hit[rails[r].first].normal.cross(u2 - u1);
-          const double length = (p - a).norm();
-          if (!(bisector.norm() > 1e-12) || !(length > 0)) continue;
-          bisector.normalize();
-          if (bisector.dot(p - a) < 0) bisector = -bisector;
-          angles += a + length * bisector;
-          ++spokes;
         }
-        if (spokes > 0) {
-          target += wa * angles / spokes;
-          weight += wa;
-        }
-      }
-      if (!(weight > 0)) continue;
-      target /= weight;
-      Eigen::Vector3d d = target - p;
-      d -= d.dot(n) * n;
-      if (!d.allFinite() || d.squaredNorm() == 0) continue;
-      bool accepted = false;
-      for (double step = options.step; !accepted && step >= options.step / 4; step /= 2) {
-        const SurfaceHit hit = surface.closest(p + step * d, old_hit);
-        // The closest point must be the surface under the vertex, not another sheet of a thin
-        // part (the far side of an ear) that happens to be nearer to the moved point.
-        if (!(hit.normal.dot(n) > kSameSheet) || (hit.point - p).norm() > 2 * step * d.norm()) continue;
-        // Nor may an edge shrink to almost nothing: near a convex corner of the surface, a whole
-        // cone of space has the corner as closest point, and vertices moved into it would merge
-        // into degenerate quads.
-        bool collapses = false;
-        for (int u : neighbours[v]) {
-          const double before = (mesh.V.row(u).transpose() - p).norm();
-          const double now = (mesh.V.row(u).transpose() - hit.point).norm();
-          collapses |= now < before && now < kShortestEdge * size;
-        }
-        if (collapses) continue;
-        mesh.V.row(v) = hit.point;
-        vertex_hit[v] = hit;
-        accepted = true;
-        after.clear();
-        after_hit.clear();
-        for (size_t k = 0; k < around[v].size() && accepted; ++k) {
-          after_hit.push_back(quad_hit[around[v][k]]);
-          after.push_back(state(around[v][k], after_hit.back()));
-          accepted = (quad_state[around[v][k]] & ~after.back()) == 0;
-        }
-      }
-      if (accepted) {
-        ++result.moves;
-        largest = std::max(largest, (mesh.V.row(v).transpose() - p).norm());
-        for (size_t k = 0; k < around[v].size(); ++k) {
-          quad_state[around[v][k]] = after[k];
-          quad_hit[around[v][k]] = after_hit[k];
-        }
+      };
+      if (threads == 1 || colour.size() < 64) {
+        for (int part = 0; part < threads; ++part) run(part);
       } else {
-        ++result.rejected;
-        mesh.V.row(v) = p;
-        vertex_hit[v] = old_hit;
+        parallel_for_each(parts, threads, "part", run);
       }
+    }
+    double largest = 0;
+    for (const Tally& t : tally) {
+      result.moves += t.moves;
+      result.rejected += t.rejected;
+      largest = std::max(largest, t.largest);
     }
     result.largest_move = size > 0 ? largest / size : 0;
     if (result.largest_move <= options.tolerance) {
@@ -249,6 +341,130 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
       break;
     }
   }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.passes < 0) throw std::invalid_argument("fitting passes must be >= 0, got " + std::to_string(options.passes));
+  if (!(options.tolerance >= 0) || !(options.reach > 0) || !(options.max_corner_deviation >= 0))
+    throw std::invalid_argument("fitting tolerance and max_corner_deviation must be >= 0 and reach > 0, got " +
+                                std::to_string(options.tolerance) + ", " + std::to_string(options.max_corner_deviation) + ", " +
+                                std::to_string(options.reach));
+  QuadFitResult result;
+  result.mesh = quads;
+  QuadMesh& mesh = result.mesh;
+  const int nv = mesh.num_vertices();
+  result.pinned.assign(nv, 0);
+  if (mesh.num_quads() == 0 || options.passes == 0) return result;
+  const TriMesh& model = surface.surface();
+  const double tolerance = options.tolerance * bounding_box(model.V).diagonal();
+  const std::vector<std::vector<int>> neighbours = vertex_neighbours(mesh.Q, nv);
+  const std::vector<std::vector<int>> around = vertex_quads(mesh.Q, nv);
+  const QuadGuard guard(mesh, surface);
+  double size = mean_quad_size(mesh);
+  std::vector<SurfaceHit> quad_hit(mesh.num_quads());
+  std::vector<int> quad_state(mesh.num_quads());
+  for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
+
+  // The model's vertices farther than the tolerance from the quads (as two triangles each, the
+  // measure's triangulation), farthest first: (distance, model vertex, quad).
+  struct Far {
+    double distance;
+    int vertex, quad;
+  };
+  auto far_vertices = [&]() {
+    const SurfaceProjector triangles(triangulate_quads(mesh));
+    std::vector<Far> far;
+    for (int w = 0; w < model.num_vertices(); ++w) {
+      const SurfaceHit hit = triangles.closest(model.V.row(w).transpose());
+      if (hit.distance > tolerance) far.push_back({hit.distance, w, hit.face / 2});
+    }
+    std::sort(far.begin(), far.end(), [](const Far& a, const Far& b) { return a.distance > b.distance; });
+    return far;
+  };
+  std::vector<Far> far = far_vertices();
+  result.farthest_before = far.empty() ? 0 : far.front().distance;
+  std::vector<int> after;
+  std::vector<SurfaceHit> after_hit;
+  for (int pass = 0; pass < options.passes && !far.empty(); ++pass) {
+    ++result.passes;
+    const QuadMesh kept_mesh = mesh;
+    const std::vector<char> kept_pinned = result.pinned;
+    const std::vector<int> kept_state = quad_state;
+    const std::vector<SurfaceHit> kept_hit = quad_hit;
+    const int kept_snapped = result.snapped;
+    int snapped = 0;
+    for (const Far& f : far) {
+      const Eigen::Vector3d x = model.V.row(f.vertex);
+      // The nearest corner of the quad the vertex is closest to, within reach.
+      int v = -1;
+      double best = options.reach * size;
+      for (int k = 0; k < 4; ++k) {
+        const int c = mesh.Q(f.quad, k);
+        const double d = (mesh.V.row(c).transpose() - x).norm();
+        if (!result.pinned[c] && d < best) {
+          best = d;
+          v = c;
+        }
+      }
+      if (v < 0) continue;
+      bool collapses = false;
+      for (int u : neighbours[v]) collapses |= (mesh.V.row(u).transpose() - x).norm() < kShortestEdge * size;
+      if (collapses) continue;
+      const Eigen::Vector3d old = mesh.V.row(v);
+      mesh.V.row(v) = x;
+      bool accepted = true;
+      after.clear();
+      after_hit.clear();
+      for (size_t k = 0; k < around[v].size() && accepted; ++k) {
+        after_hit.push_back(quad_hit[around[v][k]]);
+        after.push_back(guard.state(around[v][k], after_hit.back(), size));
+        accepted = (quad_state[around[v][k]] & ~after.back()) == 0;
+      }
+      // Nor may a corner of its quads bend farther from 90° than the limit (and than before).
+      for (size_t k = 0; k < around[v].size() && accepted; ++k) {
+        const int q = around[v][k];
+        for (int c = 0; c < 4 && accepted; ++c) {
+          const auto deviation = [&](const Eigen::Vector3d& at) {
+            Eigen::Vector3d p[4];
+            for (int i = 0; i < 4; ++i) p[i] = mesh.Q(q, i) == v ? at : Eigen::Vector3d(mesh.V.row(mesh.Q(q, i)));
+            const Eigen::Vector3d next = p[(c + 1) % 4] - p[c], previous = p[(c + 3) % 4] - p[c];
+            return std::abs(std::atan2(next.cross(previous).norm(), next.dot(previous)) * 180 / kPi - 90);
+          };
+          const double now = deviation(x);
+          accepted = now <= options.max_corner_deviation || now <= deviation(old);
+        }
+      }
+      if (!accepted) {
+        mesh.V.row(v) = old;
+        continue;
+      }
+      for (size_t k = 0; k < around[v].size(); ++k) {
+        quad_state[around[v][k]] = after[k];
+        quad_hit[around[v][k]] = after_hit[k];
+      }
+      result.pinned[v] = 1;
+      ++snapped;
+    }
+    std::vector<Far> next = far_vertices();
+    // A pass that leaves some model vertex farther from the quads than before is undone (a vertex
+    // pulled to a tip uncovers the place it left).
+    const double farthest = next.empty() ? 0 : next.front().distance;
+    if (snapped == 0 || farthest > far.front().distance) {
+      mesh = kept_mesh;
+      result.pinned = kept_pinned;
+      quad_state = kept_state;
+      quad_hit = kept_hit;
+      result.snapped = kept_snapped;
+      break;
+    }
+    result.snapped += snapped;
+    size = mean_quad_size(mesh);
+    far = std::move(next);
+  }
+  result.farthest_after = far.empty() ? 0 : far.front().distance;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -6,6 +6,8 @@
 #include "applications/quad/quad_mesh.h"
 #include "applications/quad/surface_projector.h"
 
+#include <vector>
+
 namespace polycube {
 
 struct QuadSmoothOptions {
@@ -34,6 +36,9 @@ struct QuadSmoothOptions {
   // Stop before `sweeps` once a whole sweep moves no vertex farther than this times the mean
   // quad size (square root of the mean quad area); 0: always run every sweep.
   double tolerance = 1e-3;
+  // Worker threads (vertices sharing no quad move in parallel); 0: one per hardware thread. The
+  // result does not depend on it.
+  int threads = 0;
 };
 
 // What happened.
@@ -65,8 +70,47 @@ struct QuadSmoothResult {
 // with an edge below 0.1 % of the mean quad size (both ends sent to about one point by the map: a
 // degenerate or nearly degenerate quad) is not held, so collapsed vertices can move apart (the
 // quad's diagonal test still is).
+// pinned (empty, or one flag per vertex): vertices that do not move (fit_quads' snapped ones).
 // Throws std::invalid_argument for step outside (0, 1], negative sweeps, weights or tolerance,
-// or all weights 0.
-QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadSmoothOptions& options = {});
+// all weights 0, or pinned flags of the wrong size.
+QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadSmoothOptions& options = {},
+                              const std::vector<char>& pinned = {});
+
+// Fitting the quads to the model's extremities. A uniform grid relaxed towards even squares puts
+// its vertices anywhere along the model, so tips, fins and sharp corners of the model fall inside
+// quads that cut across them: that is where the Hausdorff distance of the quads comes from. Here
+// the model's vertices farther than `tolerance` × the model's bounding-box diagonal from the quads
+// (two triangles each, as the measure splits them) pull, farthest first, the nearest corner of the
+// quad they are closest to onto themselves (only a corner within `reach` × the mean quad size,
+// not already pulled, whose edges stay above 2 % of the mean quad size), under the relaxation's
+// guard: no corner or quad of the vertex's quads turns against the surface that did not before.
+// Pulled vertices are pinned. Passes repeat while vertices are pulled; a pass after which some
+// model vertex is farther from the quads than the farthest one before it is undone.
+struct QuadFitOptions {
+  int passes = 4;
+  double tolerance = 0.002;
+  double reach = 0.75;
+  // A pull is refused when it bends a corner of the vertex's quads more than this many degrees
+  // away from 90° (unless that corner was bent farther before).
+  double max_corner_deviation = 60;
+};
+
+//   mesh       the fitted quads (same connectivity)
+//   pinned     per vertex: pulled onto a model vertex
+//   snapped    vertices pulled; passes run (including an undone one)
+//   farthest_before, farthest_after  largest distance of a model vertex from the quads (0 when
+//              none is beyond the tolerance), input units
+//   seconds    wall time
+struct QuadFitResult {
+  QuadMesh mesh;
+  std::vector<char> pinned;
+  int snapped = 0;
+  int passes = 0;
+  double farthest_before = 0, farthest_after = 0;
+  double seconds = 0;
+};
+
+// Throws std::invalid_argument for negative passes, tolerance or max_corner_deviation, or reach <= 0.
+QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options = {});
 
 }  // namespace polycube

@@ -19,6 +19,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -238,6 +239,61 @@ TEST(QuadCarry, RemeshPipeline) {
   EXPECT_LE(r.quality.max_distance_to_surface, 1e-12 * r.quality.diagonal);
   EXPECT_GE(r.seconds_grid, 0);
   EXPECT_THROW(smooth_quads(r.mesh, surface, QuadSmoothOptions{1, 0.0}), std::invalid_argument);
+}
+
+// The fit after the relaxation: a model vertex that sticks out between the quads (a spike on the
+// sphere) pulls the nearest quad corner onto itself; nothing else about the mesh gets worse.
+TEST(QuadCarry, FitPullsACornerOntoATip) {
+  const CubeSphere c = cube_sphere(1500);
+  TriMesh spiked = test::make_sphere(4);
+  // A model vertex about 0.4 quad sizes from the nearest quad corner (within the fit's reach),
+  // raised by 4 % of the radius.
+  const double size = std::sqrt(4 * M_PI / c.quads.num_quads());
+  int tip = 0;
+  double best = INFINITY;
+  for (int w = 0; w < spiked.num_vertices(); ++w) {
+    double nearest = INFINITY;
+    for (int v = 0; v < c.quads.num_vertices(); ++v) nearest = std::min(nearest, (c.quads.V.row(v) - spiked.V.row(w)).norm());
+    if (std::abs(nearest - 0.4 * size) < best) {
+      best = std::abs(nearest - 0.4 * size);
+      tip = w;
+    }
+  }
+  spiked.V.row(tip) *= 1.04;
+  const SurfaceProjector model(spiked);
+  QuadMesh quads = c.quads;
+  for (int v = 0; v < quads.num_vertices(); ++v) quads.V.row(v) = model.closest(quads.V.row(v).transpose()).point;
+  const QuadQuality before = measure_quads(quads, model, c.grid.corners);
+  ASSERT_EQ(before.flipped_quads, 0);
+
+  const QuadFitResult fit = fit_quads(quads, model);
+  EXPECT_EQ(fit.mesh.Q, quads.Q);
+  EXPECT_GE(fit.snapped, 1);
+  EXPECT_EQ(std::count(fit.pinned.begin(), fit.pinned.end(), 1), fit.snapped);
+  EXPECT_GT(fit.farthest_before, 0.002 * before.diagonal);
+  EXPECT_LT(fit.farthest_after, fit.farthest_before);
+  bool on_tip = false;
+  for (int v = 0; v < fit.mesh.num_vertices(); ++v) on_tip |= fit.mesh.V.row(v) == spiked.V.row(tip);
+  EXPECT_TRUE(on_tip) << "a corner sits on the tip";
+  for (int v = 0; v < fit.mesh.num_vertices(); ++v)
+    if (!fit.pinned[v]) EXPECT_EQ(fit.mesh.V.row(v), quads.V.row(v)) << "only pulled vertices move";
+  const QuadQuality after = measure_quads(fit.mesh, model, c.grid.corners);
+  EXPECT_EQ(after.flipped_quads, 0);
+  EXPECT_LE(after.inverted_corners, before.inverted_corners);
+  EXPECT_EQ(after.degenerate_quads, 0);
+  EXPECT_LT(after.model_to_quads, before.model_to_quads);
+  EXPECT_LE(after.max_distance_to_surface, 1e-12);
+
+  // Pinned vertices stay where the fit put them through a relaxation.
+  QuadSmoothOptions options;
+  options.sweeps = 5;
+  const QuadSmoothResult relaxed = smooth_quads(fit.mesh, model, options, fit.pinned);
+  for (int v = 0; v < fit.mesh.num_vertices(); ++v)
+    if (fit.pinned[v]) EXPECT_EQ(relaxed.mesh.V.row(v), fit.mesh.V.row(v));
+  EXPECT_THROW(smooth_quads(fit.mesh, model, options, std::vector<char>(3, 0)), std::invalid_argument);
+  QuadFitOptions bad;
+  bad.reach = 0;
+  EXPECT_THROW(fit_quads(quads, model, bad), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,0 +1,83 @@
+#!/usr/bin/env python3
+"""Runs `polycube quad` over a list of meshes and writes a markdown table of the results.
+
+Usage: bench/quad_bench.py [--binary build/polycube] [--output bench/quad-table.md]
+                           [--extra-args "..."] [MESH ...]
+
+Default meshes: every mesh of ../shared/data/paper and ../shared/data/dev when present
+(laurana-open with --fill-holes). Per mesh, from the --report JSON: quads, irregular vertices and
+P's cone points, angle deviation from 90° (mean / p95 / max), flipped quads / inverted corners,
+degenerate quads, the Hausdorff distance (% of the diagonal, both one-sided distances), the fit's
+pulled corners, seconds per stage, wall time and peak RSS (/usr/bin/time). Standard library only.
+"""
+import argparse
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+
+from map_bench import ROOT, default_meshes
+
+
+def run(binary, mesh, extra):
+    out = tempfile.mkdtemp(prefix="polycube-quad-bench-")
+    report_path = os.path.join(out, "report.json")
+    args = ["/usr/bin/time", "-f", "%e %M", binary, "quad", mesh, "-o", os.path.join(out, "quads.obj"),
+            "--report", report_path, "--quiet"] + extra
+    if "laurana-open" in mesh:
+        args.append("--fill-holes")
+    proc = subprocess.run(args, capture_output=True, text=True)
+    lines = proc.stderr.strip().splitlines()
+    wall, rss_mb = float("nan"), float("nan")
+    if lines and len(lines[-1].split()) == 2:
+        wall, rss_mb = float(lines[-1].split()[0]), float(lines[-1].split()[1]) / 1024
+    report = None
+    if proc.returncode == 0:
+        with open(report_path) as f:
+            report = json.load(f)
+    error = "" if proc.returncode == 0 else (lines[-2] if len(lines) >= 2 else "exit %d" % proc.returncode)
+    return proc.returncode, report, wall, rss_mb, error
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--binary", default=str(ROOT / "build" / "polycube"))
+    ap.add_argument("--output", default=str(ROOT / "bench" / "quad-table.md"))
+    ap.add_argument("--extra-args", default="")
+    ap.add_argument("meshes", nargs="*")
+    a = ap.parse_args()
+    meshes = a.meshes or default_meshes()
+    extra = a.extra_args.split() if a.extra_args else []
+    stage_names = ("read", "align", "topology", "polycube", "map", "grid", "carry", "smooth", "fit", "quality")
+    rows = []
+    for mesh in meshes:
+        name = pathlib.Path(mesh).stem
+        code, r, wall, rss, error = run(a.binary, mesh, extra)
+        if r is None:
+            rows.append("| %s | failed (exit %d): %s |%s %.2f | %.0f |" % (name, code, error.replace("|", "/"), " |" * 10, wall, rss))
+            print(name, "failed", error, file=sys.stderr)
+            continue
+        q, s = r["quality"], r["seconds"]
+        ang = q["angle_deviation_degrees"]
+        sides = q["hausdorff_sides"]
+        diag = q["diagonal"]
+        stages = " / ".join("%.2f" % s.get(k, 0) for k in stage_names)
+        rows.append("| %s | %d | %d | %d | %.2f / %.1f / %.1f | %d / %d | %d | %.3f (%.3f / %.3f) | %d | %s | %.2f | %.2f | %.0f |" % (
+            name, q["quads"], q["irregular_vertices"], q["irregular_at_corners"], ang["mean"], ang["p95"], ang["max"],
+            q["flipped_quads"], q["inverted_corners"], q["degenerate_quads"], q["hausdorff_percent_diagonal"],
+            100 * sides["quads_to_model"] / diag, 100 * sides["model_to_quads"] / diag,
+            r.get("fitting", {}).get("snapped", 0), stages, s["total"], wall, rss))
+        print(rows[-1], file=sys.stderr)
+    header = [
+        "| mesh | quads | irregular | of them at P's cones | angle dev. mean / p95 / max ° | flipped / inverted corners | degenerate | Hausdorff % diag (quads→model / model→quads) | corners pulled by the fit | seconds " + " / ".join(stage_names) + " | total s | wall s | peak RSS MB |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    with open(a.output, "w") as f:
+        f.write("\n".join(header + rows) + "\n")
+    print("wrote", a.output, file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
