@@ -178,12 +178,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   double align_seconds = 0;
   if (options.align == "auto" && options.stage != "topology") {
     const double align_start = progress.elapsed_seconds();
-    progress.stage("align", "6 orientations (input frame, principal axes): polycubes, then maps of the 3 with fewest corners, scored by flips");
+    progress.stage("align", "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 3 with fewest corners, scored by flips");
     alignment = choose_alignment(prepared.mesh, options.topology, options.polycube);
     nlohmann::json candidates = nlohmann::json::array();
     for (const AlignmentCandidate& c : alignment.candidates)
       candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle},
-                            {"seconds", c.seconds}, {"error", c.error}});
+                            {"full_budget", c.full_budget}, {"seconds", c.seconds}, {"error", c.error}});
     report["alignment"]["candidates"] = candidates;
     align_seconds = progress.elapsed_seconds() - align_start;
     if (alignment.chosen >= 0) {
@@ -192,8 +192,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       report["alignment"]["chosen"] = chosen.name;
       progress.stage("align", chosen.name + " (" + std::to_string(chosen.corners) + " corners)");
     } else {
-      report["alignment"]["chosen"] = "input frame, z up (no candidate passed the scoring budget)";
-      progress.warning("align: no orientation passed the scoring budget; keeping the input frame");
+      // Every orientation failed, with the full budget too: say why the input frame did.
+      throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
     }
   }
   report["alignment"]["rotation"] = {{rotation(0, 0), rotation(0, 1), rotation(0, 2)},

@@ -184,15 +184,15 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       AlignmentOptions align_options;
       if (options.align == "corners") align_options.mapped_candidates = 0;
       progress.stage("align", options.align == "auto"
-                                  ? "6 orientations (input frame, principal axes): polycubes, then maps of the 3 with fewest corners, scored by flips"
-                                  : "6 orientations (input frame, principal axes): the polycube with the fewest corners");
+                                  ? "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 3 with fewest corners, scored by flips"
+                                  : "orientations (input frame, principal axes, normal axes): the polycube with the fewest corners");
       const double align_start = progress.elapsed_seconds();
       alignment = choose_alignment(model, options.topology, options.polycube, align_options);
       seconds["align"] = progress.elapsed_seconds() - align_start;
-      if (alignment.chosen >= 0) {
-        rotation = alignment.rotation;
-        progress.stage("align", alignment.candidates[alignment.chosen].name);
-      }
+      if (alignment.chosen < 0)
+        throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
+      rotation = alignment.rotation;
+      progress.stage("align", alignment.candidates[alignment.chosen].name);
     }
     report["parameters"]["align"] = options.align;
     aligned = rotated(model, rotation);

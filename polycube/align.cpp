@@ -15,6 +15,25 @@
 
 namespace polycube {
 
+namespace {
+
+// Axes within 5 degrees of the coordinate axes are the coordinate axes: a model already aligned
+// (up to noise) must not be tilted by a hair, which would put its flat faces almost on planes.
+Eigen::Matrix3d snapped_to_coordinate_axes(const Eigen::Matrix3d& axes) {
+  Eigen::Matrix3d snapped = Eigen::Matrix3d::Zero();
+  bool near = true;
+  for (int i = 0; i < 3 && near; ++i) {
+    Eigen::Index k;
+    const double c = axes.row(i).cwiseAbs().maxCoeff(&k);
+    near = c > std::cos(5.0 * 3.14159265358979 / 180);
+    snapped(i, k) = axes(i, k) > 0 ? 1 : -1;
+  }
+  if (near && std::abs(snapped.determinant() - 1) < 1e-12) return snapped;
+  return axes;
+}
+
+}  // namespace
+
 Eigen::Matrix3d principal_axes(const TriMesh& mesh) {
   // Second moments of the surface, each triangle integrated exactly (vertices and centroid rule).
   double area_sum = 0;
@@ -36,18 +55,102 @@ Eigen::Matrix3d principal_axes(const TriMesh& mesh) {
   Eigen::Matrix3d axes;
   for (int i = 0; i < 3; ++i) axes.row(i) = solver.eigenvectors().col(2 - i).transpose();  // largest first
   if (axes.determinant() < 0) axes.row(2) *= -1;
-  // Axes within 5 degrees of the coordinate axes are the coordinate axes: a model already aligned
-  // (up to noise) must not be tilted by a hair, which would put its flat faces almost on planes.
-  Eigen::Matrix3d snapped = Eigen::Matrix3d::Zero();
-  bool near = true;
-  for (int i = 0; i < 3 && near; ++i) {
-    Eigen::Index k;
-    const double c = axes.row(i).cwiseAbs().maxCoeff(&k);
-    near = c > std::cos(5.0 * 3.14159265358979 / 180);
-    snapped(i, k) = axes(i, k) > 0 ? 1 : -1;
+  return snapped_to_coordinate_axes(axes);
+}
+
+Eigen::Matrix3d normal_axes(const TriMesh& mesh, int max_faces) {
+  std::vector<Eigen::Vector3d> normals;
+  std::vector<double> areas;
+  const int nf = mesh.num_faces();
+  const int stride = std::max(1, (nf + std::max(1, max_faces) - 1) / std::max(1, max_faces));
+  for (int f = 0; f < nf; f += stride) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    const double length = n.norm();
+    if (!(length > 0)) continue;
+    normals.push_back(n / length);
+    areas.push_back(length / 2);
   }
-  if (near && std::abs(snapped.determinant() - 1) < 1e-12) return snapped;
-  return axes;
+  if (normals.empty()) return Eigen::Matrix3d::Identity();
+  // Σ area (x²y² + y²z² + z²x²) of the normals in the frame whose axes are the rows of R.
+  auto energy = [&](const Eigen::Matrix3d& R) {
+    double e = 0;
+    for (size_t i = 0; i < normals.size(); ++i) {
+      const Eigen::Vector3d m = R * normals[i];
+      const Eigen::Vector3d q = m.cwiseProduct(m);
+      e += areas[i] * (q.x() * q.y() + q.y() * q.z() + q.z() * q.x());
+    }
+    return e;
+  };
+  // Start rotations: the identity and 999 more spread over SO(3) (Halton points through
+  // Shoemake's uniform quaternions), deterministic.
+  auto halton = [](int i, int base) {
+    double f = 1, r = 0;
+    for (; i > 0; i /= base) {
+      f /= base;
+      r += f * (i % base);
+    }
+    return r;
+  };
+  constexpr double kTwoPi = 6.28318530717958647692;
+  std::vector<std::pair<double, Eigen::Matrix3d>> starts;
+  starts.emplace_back(energy(Eigen::Matrix3d::Identity()), Eigen::Matrix3d::Identity());
+  for (int i = 1; i < 1000; ++i) {
+    const double u1 = halton(i, 2), u2 = halton(i, 3), u3 = halton(i, 5);
+    const Eigen::Quaterniond q(std::sqrt(u1) * std::cos(kTwoPi * u3), std::sqrt(1 - u1) * std::sin(kTwoPi * u2),
+                               std::sqrt(1 - u1) * std::cos(kTwoPi * u2), std::sqrt(u1) * std::sin(kTwoPi * u3));
+    const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+    starts.emplace_back(energy(R), R);
+  }
+  std::sort(starts.begin(), starts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  // The best few refined by small turns about the axes, halving the angle when none helps.
+  Eigen::Matrix3d best = starts.front().second;
+  double best_energy = starts.front().first;
+  for (size_t k = 0; k < std::min<size_t>(4, starts.size()); ++k) {
+    Eigen::Matrix3d R = starts[k].second;
+    double e = starts[k].first;
+    for (double step = 5 * kTwoPi / 360; step > 1e-4;) {
+      bool improved = false;
+      for (int axis = 0; axis < 3; ++axis)
+        for (const double sign : {1.0, -1.0}) {
+          const Eigen::Matrix3d turned = Eigen::AngleAxisd(sign * step, Eigen::Vector3d::Unit(axis)).toRotationMatrix() * R;
+          const double et = energy(turned);
+          if (et < e) {
+            R = turned;
+            e = et;
+            improved = true;
+          }
+        }
+      if (!improved) step /= 2;
+    }
+    if (e < best_energy) {
+      best_energy = e;
+      best = R;
+    }
+  }
+  // Of the cube's 24 equivalent frames, the one closest to the input's (largest trace).
+  Eigen::Matrix3d chosen = best;
+  double chosen_trace = -INFINITY;
+  const int permutations[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {2, 1, 0}, {1, 0, 2}};
+  for (const auto& p : permutations)
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d candidate;
+      for (int i = 0; i < 3; ++i) candidate.row(i) = (signs >> i & 1 ? -1.0 : 1.0) * best.row(p[i]);
+      if (candidate.determinant() < 0) continue;
+      if (candidate.trace() > chosen_trace) {
+        chosen_trace = candidate.trace();
+        chosen = candidate;
+      }
+    }
+  return snapped_to_coordinate_axes(chosen);
+}
+
+bool same_axes(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b, double degrees) {
+  const Eigen::Matrix3d m = a * b.transpose();
+  const double c = std::cos(degrees * 3.14159265358979 / 180);
+  for (int i = 0; i < 3; ++i)
+    if (m.row(i).cwiseAbs().maxCoeff() < c) return false;
+  return true;
 }
 
 TriMesh rotated(const TriMesh& mesh, const Eigen::Matrix3d& rotation) {
@@ -67,11 +170,16 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   const char* input_names[3] = {"input frame, z up", "input frame, x up", "input frame, y up"};
   const char* principal_names[3] = {"principal axes, least-spread axis up", "principal axes, longest axis up",
                                     "principal axes, middle axis up"};
-  for (int frame = 0; frame < 2; ++frame)
+  const char* normal_names[3] = {"normal axes, z up", "normal axes, x up", "normal axes, y up"};
+  // The normals' frame only when it is neither of the others (a CAD part in its own frame, or a
+  // box, already has it).
+  const Eigen::Matrix3d normals = normal_axes(mesh);
+  const bool distinct_normals = !same_axes(normals, Eigen::Matrix3d::Identity()) && !same_axes(normals, pca);
+  for (int frame = 0; frame < (distinct_normals ? 3 : 2); ++frame)
     for (int k = 0; k < 3; ++k) {
       AlignmentCandidate c;
-      c.name = frame == 0 ? input_names[k] : principal_names[k];
-      c.rotation = cycles[k] * (frame == 0 ? Eigen::Matrix3d::Identity() : pca);
+      c.name = frame == 0 ? input_names[k] : frame == 1 ? principal_names[k] : normal_names[k];
+      c.rotation = cycles[k] * (frame == 0 ? Eigen::Matrix3d::Identity() : frame == 1 ? pca : normals);
       out.candidates.push_back(c);
     }
   PolycubeOptions scoring = polycube;
@@ -140,6 +248,23 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   for (int i = 0; i < n; ++i) {
     if (!polycubes[i]) continue;
     if (out.chosen < 0 || key(i) < key(out.chosen)) out.chosen = i;
+  }
+  if (out.chosen < 0 && options.full_budget_fallback) {
+    // Nothing passed the small budget: the full one, candidate by candidate, the first that builds.
+    for (int i = 0; i < n && out.chosen < 0; ++i) {
+      AlignmentCandidate& c = out.candidates[i];
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
+        polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], polycube));
+        c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
+        c.full_budget = true;
+        out.chosen = i;
+      } catch (const Error& e) {
+        c.error = e.what();
+      }
+      c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
   }
   if (out.chosen >= 0) {
     out.topology = topologies[out.chosen];

@@ -1,8 +1,11 @@
 // Auto-orientation (the paper's limitation 1: its polycube depends on how the model is turned).
-// Candidates are the input frame and the model's principal axes, each with each of its three axes
-// as the sweep direction z. Each gets its polycube (under a small repair budget); the few with the
-// fewest corners also get their map, and the map with the fewest flipped image triangles (then the
-// least ε_angle, then the fewest corners) wins.
+// Candidates are the input frame, the model's principal axes and the frame its surface normals
+// align with best (normal_axes; left out when it is one of the other two), each with each of its
+// three axes as the sweep direction z. Each gets its polycube (under a small repair budget); the
+// few with the fewest corners also get their map, and the map with the fewest flipped image
+// triangles (then the least ε_angle, then the fewest corners) wins. When no candidate passes the
+// budget, they are tried again in order with the caller's full budget, and the first that builds
+// wins (an invalid polycube is never returned: build_polycube throws instead).
 #pragma once
 
 #include "polycube/mesh.h"
@@ -21,17 +24,21 @@ namespace polycube {
 // One orientation tried: x_aligned = rotation * x_input (a proper rotation).
 //   corners  of the polycube built in it (-1 if the stages failed there, see error)
 //   flipped, eps_angle  of its map before smoothing, both directions (-1 if not mapped)
+//   full_budget  its polycube was built by the full-budget fallback (no candidate passed the
+//            scoring budget)
 struct AlignmentCandidate {
   std::string name;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   int corners = -1;
   int flipped = -1;
   double eps_angle = -1;
+  bool full_budget = false;
   double seconds = 0;
   std::string error;
 };
 
-//   chosen     index of the winner, -1 if every candidate failed within the scoring budget
+//   chosen     index of the winner, -1 if every candidate failed (within the scoring budget, and
+//              with the full budget when full_budget_fallback is on)
 //   topology, polycube, map  the winner's stages (built on the turned model), so they need not be
 //              redone (map is null when the winner was not mapped)
 struct Alignment {
@@ -46,6 +53,20 @@ struct Alignment {
 // Principal axes of the surface (area-weighted covariance of the triangles), as the rows of a
 // proper rotation, largest variance first.
 Eigen::Matrix3d principal_axes(const TriMesh& mesh);
+
+// The frame whose axes the surface normals align with best, as the rows of a proper rotation: the
+// minimiser of Σ_f area_f (x²y² + y²z² + z²x²) over the faces' unit normals (x, y, z) in that
+// frame, which is 0 exactly when every face is perpendicular to an axis (a CAD part in its own
+// frame). Found by evaluating a fixed set of 1000 rotations, then refining the best few by
+// rotations about the axes (to about 0.01°), on at most max_faces faces (every k-th). Axes
+// within 5° of the coordinate axes are the coordinate axes, as for principal_axes. Defined only
+// up to the cube's 24 rotations; which of them is returned is fixed (the axis most aligned with
+// the input's z becomes z, ...).
+Eigen::Matrix3d normal_axes(const TriMesh& mesh, int max_faces = 20000);
+
+// Whether two frames differ only by one of the cube's rotations (axes permuted and flipped),
+// within `degrees`.
+bool same_axes(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b, double degrees = 1);
 
 // The mesh turned by `rotation` about the origin (V * rotation^T).
 TriMesh rotated(const TriMesh& mesh, const Eigen::Matrix3d& rotation);
@@ -62,9 +83,13 @@ struct AlignmentOptions {
   // How many candidates (fewest corners first) get their map built and audited first; if all of
   // those still have flipped triangles, the rest are mapped too. 0: corners only.
   int mapped_candidates = 3;
+  // When no candidate passes the scoring budget, build them again with the full budget, in order,
+  // until one succeeds (then chosen is that one, with its topology and polycube but no map).
+  bool full_budget_fallback = true;
 };
 
-// Scores the six candidates (input frame / principal axes × which axis is z); see the top.
+// Scores the candidates (input frame / principal axes / normal axes × which axis is z); see the
+// top.
 Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology, const PolycubeOptions& polycube,
                            const AlignmentOptions& options = {});
 

@@ -1,5 +1,5 @@
-// Auto-orientation: principal axes of a known box, snapping of aligned models, and the candidate
-// scoring keeps a valid winner.
+// Auto-orientation: principal axes and normal axes of a known box, snapping of aligned models, the
+// candidate scoring keeps a valid winner, and the full-budget fallback.
 #include "polycube/align.h"
 
 #include "support/generated_meshes.h"
@@ -45,12 +45,54 @@ TEST(Align, AlignedModelsAreNotTilted) {
   EXPECT_GT((principal_axes(rotated(box(Eigen::Vector3d::Zero()), large)).cwiseAbs() - Eigen::Matrix3d::Identity()).norm(), 0.1);
 }
 
+// A box turned anyhow: its faces' normals give back its frame (up to the cube's rotations), even
+// for a box whose proportions make the principal axes useless (a cube: any frame is principal).
+TEST(Align, NormalAxesOfATurnedBoxAreItsFaces) {
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(1.1, Eigen::Vector3d(-2, 1, 4).normalized()).toRotationMatrix();
+  TriMesh cube = box(Eigen::Vector3d(1, 2, 3));
+  cube.V.col(0) /= 2;  // 2 x 2 x 1
+  cube.V.col(2) *= 2;  // 2 x 2 x 2
+  const TriMesh turned = rotated(cube, turn);
+  const Eigen::Matrix3d axes = normal_axes(turned);
+  EXPECT_NEAR(axes.determinant(), 1.0, 1e-12);
+  EXPECT_TRUE(same_axes(axes, turn.transpose(), 0.05)) << axes;
+  EXPECT_FALSE(same_axes(axes, Eigen::Matrix3d::Identity(), 5));
+  // In the input frame already (up to 2°): exactly the coordinate axes.
+  const Eigen::Matrix3d small = Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d(1, 0, 0)).toRotationMatrix();
+  const Eigen::Matrix3d snapped = normal_axes(rotated(cube, small));
+  EXPECT_TRUE(same_axes(snapped, Eigen::Matrix3d::Identity(), 1e-9)) << snapped;
+  EXPECT_EQ(snapped.cwiseAbs().sum(), 3.0);
+}
+
+// Nothing passes a scoring budget of one round (rotor needs several): the candidates are built
+// again with the full budget, in order, and the first that builds is chosen, unmapped.
+TEST(Align, FallsBackToTheFullBudget) {
+  const TriMesh model = load_test_mesh("rotor.off");
+  AlignmentOptions tight;
+  tight.max_rounds = 1;
+  tight.max_inserted_planes = 0;
+  tight.full_budget_fallback = false;
+  const Alignment none = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, tight);
+  for (const AlignmentCandidate& c : none.candidates) ASSERT_LT(c.corners, 0) << c.name << " passed one round";
+  EXPECT_EQ(none.chosen, -1);
+  tight.full_budget_fallback = true;
+  const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, tight);
+  ASSERT_EQ(a.chosen, 0) << "the input frame builds with the full budget";
+  EXPECT_TRUE(a.candidates[0].full_budget);
+  ASSERT_TRUE(a.polycube);
+  EXPECT_EQ(a.polycube->genus, 1);
+  EXPECT_FALSE(a.map);
+  EXPECT_EQ(a.rotation, Eigen::Matrix3d::Identity());
+}
+
 // The winner is the mapped candidate with the fewest flipped triangles (then least ε_angle); the
 // three with the fewest corners are always mapped; the winner's stages come with it.
 TEST(Align, ChoosesTheMappedCandidateWithFewestFlips) {
   const TriMesh model = load_test_mesh("knot.off");
   const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{});
-  ASSERT_EQ(a.candidates.size(), 6u);
+  // Input frame and principal axes, and the normals' frame unless it is one of those.
+  const bool distinct = !same_axes(normal_axes(model), Eigen::Matrix3d::Identity()) && !same_axes(normal_axes(model), principal_axes(model));
+  ASSERT_EQ(a.candidates.size(), distinct ? 9u : 6u);
   ASSERT_GE(a.chosen, 0);
   const AlignmentCandidate& w = a.candidates[a.chosen];
   ASSERT_GE(w.flipped, 0) << "the winner was mapped";
