@@ -1,6 +1,7 @@
 // Auto-orientation (the paper's limitation 1: its polycube depends on how the model is turned).
 // Candidates are the input frame, the model's principal axes and the frame its surface normals
-// align with best (normal_axes; left out when it is one of the other two), each with each of its
+// align with best (normal_axes; only when they align markedly, as a CAD part's do, and it is not
+// one of the other two), each with each of its
 // three axes as the sweep direction z. Each gets its polycube (under a small repair budget); the
 // few with the fewest corners also get their map, and the map with the fewest flipped image
 // triangles (then the least ε_angle, then the fewest corners) wins. When no candidate passes the
@@ -61,8 +62,9 @@ Eigen::Matrix3d principal_axes(const TriMesh& mesh);
 // rotations about the axes (to about 0.01°), on at most max_faces faces (every k-th). Axes
 // within 5° of the coordinate axes are the coordinate axes, as for principal_axes. Defined only
 // up to the cube's 24 rotations; which of them is returned is fixed (the axis most aligned with
-// the input's z becomes z, ...).
-Eigen::Matrix3d normal_axes(const TriMesh& mesh, int max_faces = 20000);
+// the input's z becomes z, ...). misalignment (optional): the minimum divided by the total area
+// (0: every face perpendicular to an axis; 0.2 for normals spread evenly over the sphere).
+Eigen::Matrix3d normal_axes(const TriMesh& mesh, int max_faces = 20000, double* misalignment = nullptr);
 
 // Whether two frames differ only by one of the cube's rotations (axes permuted and flipped),
 // within `degrees`.
@@ -83,6 +85,8 @@ struct AlignmentOptions {
   // How many candidates (fewest corners first) get their map built and audited first; if all of
   // those still have flipped triangles, the rest are mapped too. 0: corners only.
   int mapped_candidates = 3;
+  // The normals' frame is a candidate when its misalignment (normal_axes) is below this.
+  double normal_axes_misalignment = 0.12;
   // When no candidate passes the scoring budget, build them again with the full budget, in order,
   // until one succeeds (then chosen is that one, with its topology and polycube but no map).
   bool full_budget_fallback = true;

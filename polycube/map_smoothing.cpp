@@ -1071,6 +1071,8 @@ PhaseResult run_phase(const PhaseInput& in, const MapSmoothingOptions& options) 
       best = result;
       best.found = true;
     }
+    // No flip left in either direction: later rounds (more vertices frozen) can only smooth less.
+    if (best.found && best_flips == 0) break;
     // Freeze, for the next round (which starts from the phase's start again), the tangles the
     // sweeps left and every place where this round is worse than the start: a triangle of either
     // direction flipped that was not, or a target vertex that could not be located. Frozen

@@ -64,6 +64,25 @@ TEST(Align, NormalAxesOfATurnedBoxAreItsFaces) {
   EXPECT_EQ(snapped.cwiseAbs().sum(), 3.0);
 }
 
+// A CAD part turned anyhow: its normals give its own frame back, which becomes a candidate.
+TEST(Align, TurnedCadPartGetsItsFrameBack) {
+  const TriMesh joint = load_test_mesh("joint.off");
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.9, Eigen::Vector3d(3, -1, 2).normalized()).toRotationMatrix();
+  const TriMesh turned = rotated(joint, turn);
+  double own = 0, after = 0;
+  const Eigen::Matrix3d frame = normal_axes(joint, 20000, &own);
+  const Eigen::Matrix3d found = normal_axes(turned, 20000, &after);
+  EXPECT_LT(own, 0.1);
+  EXPECT_NEAR(after, own, 1e-6);
+  EXPECT_TRUE(same_axes(found, frame * turn.transpose(), 0.1)) << found << "\n" << frame * turn.transpose();
+  AlignmentOptions options;
+  options.mapped_candidates = 0;
+  const Alignment a = choose_alignment(turned, TopologyOptions{}, PolycubeOptions{}, options);
+  ASSERT_EQ(a.candidates.size(), 9u);
+  EXPECT_EQ(a.candidates[6].name.rfind("normal axes", 0), 0u);
+  EXPECT_LT((a.candidates[6].rotation - found).norm(), 1e-12);
+}
+
 // Nothing passes a scoring budget of one round (rotor needs several): the candidates are built
 // again with the full budget, in order, and the first that builds is chosen, unmapped.
 TEST(Align, FallsBackToTheFullBudget) {
@@ -90,9 +109,11 @@ TEST(Align, FallsBackToTheFullBudget) {
 TEST(Align, ChoosesTheMappedCandidateWithFewestFlips) {
   const TriMesh model = load_test_mesh("knot.off");
   const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{});
-  // Input frame and principal axes, and the normals' frame unless it is one of those.
-  const bool distinct = !same_axes(normal_axes(model), Eigen::Matrix3d::Identity()) && !same_axes(normal_axes(model), principal_axes(model));
-  ASSERT_EQ(a.candidates.size(), distinct ? 9u : 6u);
+  // Input frame and principal axes; the knot's normals align with no frame (a smooth tube).
+  double misalignment = 0;
+  normal_axes(model, 20000, &misalignment);
+  EXPECT_GT(misalignment, 0.15);
+  ASSERT_EQ(a.candidates.size(), 6u);
   ASSERT_GE(a.chosen, 0);
   const AlignmentCandidate& w = a.candidates[a.chosen];
   ASSERT_GE(w.flipped, 0) << "the winner was mapped";
