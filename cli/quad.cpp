@@ -34,7 +34,7 @@ struct QuadCommandOptions {
   int target_faces = 10000;
   double cell_size = 0;
   std::string map_dir;
-  int smooth = 60;
+  int smooth = 40;
   bool fit = true;
   std::string report_path;
   std::string preview_path;

@@ -1,5 +1,7 @@
 #include "polycube/map_smoothing.h"
 
+#include "polycube/closest_point.h"
+
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
 
@@ -48,41 +50,7 @@ Vec3 normalized_bary(const Vec3& w) {
   return s > 0 ? Vec3(c / s) : Vec3(1.0 / 3, 1.0 / 3, 1.0 / 3);
 }
 
-// Closest point on a triangle (Ericson, Real-Time Collision Detection, 5.1.5), with barycentrics.
-struct Closest {
-  Vec3 point;
-  Vec3 bary;
-};
-
-Closest closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return {a, {1, 0, 0}};
-  const Vec3 bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return {b, {0, 1, 0}};
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const double v = d1 / (d1 - d3);
-    return {a + v * ab, {1 - v, v, 0}};
-  }
-  const Vec3 cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return {c, {0, 0, 1}};
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const double w = d2 / (d2 - d6);
-    return {a + w * ac, {1 - w, 0, w}};
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {b + w * (c - b), {0, 1 - w, w}};
-  }
-  const double denom = 1 / (va + vb + vc);
-  const double v = vb * denom, w = vc * denom;
-  return {a + ab * v + ac * w, {1 - v - w, v, w}};
-}
+using Closest = TriangleClosest;
 
 // Compressed lists: the items of key k are items[begin[k] .. begin[k + 1]).
 struct Lists {

@@ -2,6 +2,7 @@
 
 #include "applications/quad/quad_quality.h"
 
+#include "polycube/closest_point.h"
 #include "polycube/parallel.h"
 
 #include <Eigen/Geometry>
@@ -110,8 +111,8 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
                               const std::vector<char>& pinned) {
   const auto start = std::chrono::steady_clock::now();
   if (options.sweeps < 0) throw std::invalid_argument("smoothing sweeps must be >= 0, got " + std::to_string(options.sweeps));
-  if (!(options.step > 0 && options.step <= 1))
-    throw std::invalid_argument("smoothing step must be in (0, 1], got " + std::to_string(options.step));
+  if (!(options.step > 0 && options.step <= 2))
+    throw std::invalid_argument("smoothing step must be in (0, 2], got " + std::to_string(options.step));
   const double wl = options.average_weight, wa = options.angle_weight, wc = options.cross_weight;
   if (!(wl >= 0 && wa >= 0 && wc >= 0 && wl + wa + wc > 0))
     throw std::invalid_argument("smoothing weights must be >= 0 and not all 0, got " + std::to_string(wl) + ", " +
@@ -368,41 +369,73 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   std::vector<int> quad_state(mesh.num_quads());
   for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
 
-  // The model's vertices farther than the tolerance from the quads (as two triangles each, the
-  // measure's triangulation), farthest first: (distance, model vertex, quad).
-  struct Far {
-    double distance;
-    int vertex, quad;
-  };
-  auto far_vertices = [&]() {
+  // Distance of every model vertex from the quads (two triangles each, split as the measure
+  // splits them) and the quad it is closest to; per quad, the model vertices closest to it.
+  std::vector<double> distance(model.num_vertices(), 0);
+  std::vector<int> owner(model.num_vertices(), -1);
+  std::vector<std::vector<int>> owned(mesh.num_quads());
+  auto measure_all = [&]() {
     const SurfaceProjector triangles(triangulate_quads(mesh));
-    std::vector<Far> far;
+    for (auto& list : owned) list.clear();
     for (int w = 0; w < model.num_vertices(); ++w) {
       const SurfaceHit hit = triangles.closest(model.V.row(w).transpose());
-      if (hit.distance > tolerance) far.push_back({hit.distance, w, hit.face / 2});
+      distance[w] = hit.distance;
+      owner[w] = hit.face / 2;
+      owned[owner[w]].push_back(w);
     }
-    std::sort(far.begin(), far.end(), [](const Far& a, const Far& b) { return a.distance > b.distance; });
-    return far;
   };
-  std::vector<Far> far = far_vertices();
-  result.farthest_before = far.empty() ? 0 : far.front().distance;
-  std::vector<int> after;
+  // Distance of x from quad q as two triangles along its shorter diagonal (triangulate_quads).
+  auto quad_distance = [&](int q, const Eigen::Vector3d& x) {
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
+    const bool first = (p[0] - p[2]).squaredNorm() <= (p[1] - p[3]).squaredNorm();
+    const int t[2][3] = {{0, 1, 2}, {0, 2, 3}}, u[2][3] = {{1, 2, 3}, {1, 3, 0}};
+    double best = INFINITY;
+    for (int h = 0; h < 2; ++h) {
+      const int* c = first ? t[h] : u[h];
+      best = std::min(best, (closest_on_triangle(x, p[c[0]], p[c[1]], p[c[2]]).point - x).norm());
+    }
+    return best;
+  };
+  auto farthest = [&]() { return distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end()); };
+  // How far v's quads stray from the model: the largest distance of their edge midpoints and of
+  // the centres of their two triangles (split as the measure splits them).
+  auto off_model = [&](int v) {
+    double off = 0;
+    for (int q : around[v]) {
+      Eigen::Vector3d p[4];
+      for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
+      const bool first = (p[0] - p[2]).squaredNorm() <= (p[1] - p[3]).squaredNorm();
+      const Eigen::Vector3d samples[6] = {(p[0] + p[1]) / 2, (p[1] + p[2]) / 2, (p[2] + p[3]) / 2, (p[3] + p[0]) / 2,
+                                          first ? (p[0] + p[1] + p[2]) / 3 : (p[1] + p[2] + p[3]) / 3,
+                                          first ? (p[0] + p[2] + p[3]) / 3 : (p[1] + p[3] + p[0]) / 3};
+      for (const Eigen::Vector3d& y : samples) off = std::max(off, surface.closest(y, quad_hit[q]).distance);
+    }
+    return off;
+  };
+  measure_all();
+  result.farthest_before = farthest();
+  std::vector<int> after, nearby, recheck;
+  std::vector<std::pair<int, double>> moved_to;
   std::vector<SurfaceHit> after_hit;
-  for (int pass = 0; pass < options.passes && !far.empty(); ++pass) {
+  for (int pass = 0; pass < options.passes; ++pass) {
+    // The model vertices beyond the tolerance, farthest first.
+    std::vector<int> far;
+    for (int w = 0; w < model.num_vertices(); ++w)
+      if (distance[w] > tolerance) far.push_back(w);
+    if (far.empty()) break;
     ++result.passes;
-    const QuadMesh kept_mesh = mesh;
-    const std::vector<char> kept_pinned = result.pinned;
-    const std::vector<int> kept_state = quad_state;
-    const std::vector<SurfaceHit> kept_hit = quad_hit;
-    const int kept_snapped = result.snapped;
+    std::sort(far.begin(), far.end(), [&](int a, int b) { return distance[a] > distance[b]; });
+    const double limit = distance[far.front()];  // no model vertex may end farther than this
     int snapped = 0;
-    for (const Far& f : far) {
-      const Eigen::Vector3d x = model.V.row(f.vertex);
+    for (const int w : far) {
+      if (!(distance[w] > tolerance)) continue;  // an earlier pull covered it
+      const Eigen::Vector3d x = model.V.row(w);
       // The nearest corner of the quad the vertex is closest to, within reach.
       int v = -1;
       double best = options.reach * size;
       for (int k = 0; k < 4; ++k) {
-        const int c = mesh.Q(f.quad, k);
+        const int c = mesh.Q(owner[w], k);
         const double d = (mesh.V.row(c).transpose() - x).norm();
         if (!result.pinned[c] && d < best) {
           best = d;
@@ -414,6 +447,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
       for (int u : neighbours[v]) collapses |= (mesh.V.row(u).transpose() - x).norm() < kShortestEdge * size;
       if (collapses) continue;
       const Eigen::Vector3d old = mesh.V.row(v);
+      const double off_before = off_model(v);
       mesh.V.row(v) = x;
       bool accepted = true;
       after.clear();
@@ -423,6 +457,8 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
         after.push_back(guard.state(around[v][k], after_hit.back(), size));
         accepted = (quad_state[around[v][k]] & ~after.back()) == 0;
       }
+      // Nor may v's quads move off the model: sampled, no farther than the tolerance or than before.
+      if (accepted) accepted = off_model(v) <= std::max(tolerance, off_before);
       // Nor may a corner of its quads bend farther from 90° than the limit (and than before).
       for (size_t k = 0; k < around[v].size() && accepted; ++k) {
         const int q = around[v][k];
@@ -437,6 +473,34 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
           accepted = now <= options.max_corner_deviation || now <= deviation(old);
         }
       }
+      // Nor may the place v leaves be uncovered: the model vertices closest to v's quads must stay
+      // within the farthest distance of the pass (measured to the quads round v's quads' corners,
+      // an upper bound of their distance to the whole mesh).
+      moved_to.clear();
+      if (accepted) {
+        nearby.clear();
+        for (int q : around[v])
+          for (int k = 0; k < 4; ++k)
+            for (int r : around[mesh.Q(q, k)]) nearby.push_back(r);
+        std::sort(nearby.begin(), nearby.end());
+        nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
+        recheck.clear();
+        for (int q : around[v]) recheck.insert(recheck.end(), owned[q].begin(), owned[q].end());
+        for (size_t i = 0; i < recheck.size() && accepted; ++i) {
+          const Eigen::Vector3d y = model.V.row(recheck[i]);
+          int nearest = -1;
+          double d = INFINITY;
+          for (int r : nearby) {
+            const double dr = quad_distance(r, y);
+            if (dr < d) {
+              d = dr;
+              nearest = r;
+            }
+          }
+          accepted = d <= std::max(limit, distance[recheck[i]]);
+          moved_to.emplace_back(nearest, d);
+        }
+      }
       if (!accepted) {
         mesh.V.row(v) = old;
         continue;
@@ -445,26 +509,25 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
         quad_state[around[v][k]] = after[k];
         quad_hit[around[v][k]] = after_hit[k];
       }
+      // The rechecked model vertices' new distances and quads.
+      for (size_t i = 0; i < recheck.size(); ++i) {
+        const int y = recheck[i];
+        std::vector<int>& from = owned[owner[y]];
+        from.erase(std::find(from.begin(), from.end(), y));
+        owner[y] = moved_to[i].first;
+        distance[y] = moved_to[i].second;
+        owned[owner[y]].push_back(y);
+      }
+      distance[w] = 0;
       result.pinned[v] = 1;
       ++snapped;
     }
-    std::vector<Far> next = far_vertices();
-    // A pass that leaves some model vertex farther from the quads than before is undone (a vertex
-    // pulled to a tip uncovers the place it left).
-    const double farthest = next.empty() ? 0 : next.front().distance;
-    if (snapped == 0 || farthest > far.front().distance) {
-      mesh = kept_mesh;
-      result.pinned = kept_pinned;
-      quad_state = kept_state;
-      quad_hit = kept_hit;
-      result.snapped = kept_snapped;
-      break;
-    }
+    if (snapped == 0) break;
     result.snapped += snapped;
     size = mean_quad_size(mesh);
-    far = std::move(next);
+    measure_all();
   }
-  result.farthest_after = far.empty() ? 0 : far.front().distance;
+  result.farthest_after = farthest();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

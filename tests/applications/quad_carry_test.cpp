@@ -239,6 +239,7 @@ TEST(QuadCarry, RemeshPipeline) {
   EXPECT_LE(r.quality.max_distance_to_surface, 1e-12 * r.quality.diagonal);
   EXPECT_GE(r.seconds_grid, 0);
   EXPECT_THROW(smooth_quads(r.mesh, surface, QuadSmoothOptions{1, 0.0}), std::invalid_argument);
+  EXPECT_THROW(smooth_quads(r.mesh, surface, QuadSmoothOptions{1, 2.5}), std::invalid_argument);
 }
 
 // The fit after the relaxation: a model vertex that sticks out between the quads (a spike on the
