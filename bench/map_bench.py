@@ -44,9 +44,10 @@ def default_meshes():
     return meshes
 
 
-def run(binary, mesh, extra):
-    out = tempfile.mkdtemp(prefix="polycube-bench-")
-    args = ["/usr/bin/time", "-f", "%e %M", binary, "map", mesh, "-o", out, "--quiet"] + extra
+def run_command(command, mesh, report_path):
+    """Runs a polycube command under /usr/bin/time (the laurana-open mesh closed by --fill-holes).
+    Returns (exit code, the report read from report_path or None, wall s, peak RSS MB, error)."""
+    args = ["/usr/bin/time", "-f", "%e %M"] + command
     if "laurana-open" in mesh:
         args.append("--fill-holes")
     start = time.time()
@@ -56,10 +57,15 @@ def run(binary, mesh, extra):
     rss_mb = float(lines[-1].split()[1]) / 1024 if lines and len(lines[-1].split()) == 2 else float("nan")
     report = None
     if proc.returncode == 0:
-        with open(os.path.join(out, "report.json")) as f:
+        with open(report_path) as f:
             report = json.load(f)
     error = "" if proc.returncode == 0 else (lines[-2] if len(lines) >= 2 else "exit %d" % proc.returncode)
     return proc.returncode, report, wall, rss_mb, error
+
+
+def run(binary, mesh, extra):
+    out = tempfile.mkdtemp(prefix="polycube-bench-")
+    return run_command([binary, "map", mesh, "-o", out, "--quiet"] + extra, mesh, os.path.join(out, "report.json"))
 
 
 def main():

@@ -11,34 +11,19 @@ degenerate quads, the Hausdorff distance (% of the diagonal, both one-sided dist
 pulled corners, seconds per stage, wall time and peak RSS (/usr/bin/time). Standard library only.
 """
 import argparse
-import json
 import os
 import pathlib
-import subprocess
 import sys
 import tempfile
 
-from map_bench import ROOT, default_meshes
+from map_bench import ROOT, default_meshes, run_command
 
 
 def run(binary, mesh, extra):
     out = tempfile.mkdtemp(prefix="polycube-quad-bench-")
     report_path = os.path.join(out, "report.json")
-    args = ["/usr/bin/time", "-f", "%e %M", binary, "quad", mesh, "-o", os.path.join(out, "quads.obj"),
-            "--report", report_path, "--quiet"] + extra
-    if "laurana-open" in mesh:
-        args.append("--fill-holes")
-    proc = subprocess.run(args, capture_output=True, text=True)
-    lines = proc.stderr.strip().splitlines()
-    wall, rss_mb = float("nan"), float("nan")
-    if lines and len(lines[-1].split()) == 2:
-        wall, rss_mb = float(lines[-1].split()[0]), float(lines[-1].split()[1]) / 1024
-    report = None
-    if proc.returncode == 0:
-        with open(report_path) as f:
-            report = json.load(f)
-    error = "" if proc.returncode == 0 else (lines[-2] if len(lines) >= 2 else "exit %d" % proc.returncode)
-    return proc.returncode, report, wall, rss_mb, error
+    return run_command([binary, "quad", mesh, "-o", os.path.join(out, "quads.obj"), "--report", report_path, "--quiet"] + extra,
+                       mesh, report_path)
 
 
 def main():

@@ -22,9 +22,10 @@ namespace {
 
 // A shipped model, its polycube and map (default options, input orientation).
 struct Mapped {
-  TriMesh model;
-  PolycubeResult polycube;
-  PolycubeMap map;
+  const test::MappedModel& stages;
+  const TriMesh& model;
+  const PolycubeResult& polycube;
+  const PolycubeMap& map;
   std::unique_ptr<SurfaceProjector> projector;
 };
 
@@ -32,11 +33,8 @@ const Mapped& mapped(const std::string& name) {
   static std::map<std::string, std::unique_ptr<Mapped>> cache;
   std::unique_ptr<Mapped>& slot = cache[name];
   if (!slot) {
-    slot = std::make_unique<Mapped>();
-    slot->model = test::load_test_mesh(name);
-    slot->polycube = build_polycube(slot->model, analyse_topology(slot->model));
-    slot->map = build_polycube_map(slot->model, slot->polycube);
-    slot->projector = std::make_unique<SurfaceProjector>(slot->model);
+    const test::MappedModel& m = test::mapped_model(name);
+    slot.reset(new Mapped{m, m.model, m.polycube, m.map, std::make_unique<SurfaceProjector>(m.model)});
   }
   return *slot;
 }

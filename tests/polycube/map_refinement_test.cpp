@@ -28,24 +28,8 @@ namespace {
 
 using namespace test;
 
-struct Pipeline {
-  TriMesh model;
-  PolycubeResult polycube;
-  PolycubeMap map;
-};
-
-// The pipeline up to stage 4 once per mesh (several tests share it).
-const Pipeline& pipeline(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<Pipeline>> cache;
-  auto& slot = cache[name];
-  if (!slot) {
-    slot = std::make_unique<Pipeline>();
-    slot->model = load_test_mesh(name);
-    slot->polycube = build_polycube(slot->model, analyse_topology(slot->model));
-    slot->map = build_polycube_map(slot->model, slot->polycube);
-  }
-  return *slot;
-}
+using Pipeline = MappedModel;
+const Pipeline& pipeline(const std::string& name) { return mapped_model(name); }
 
 int bad(const MapDirectionAudit& a) { return a.flipped + a.degenerate; }
 

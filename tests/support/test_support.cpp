@@ -1,7 +1,9 @@
 #include "support/test_support.h"
 
 #include "formats/mesh_io.h"
+#include "polycube/topology.h"
 #include "polycube/validate.h"
+#include "support/generated_meshes.h"
 
 #include <sys/wait.h>
 
@@ -11,6 +13,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <mutex>
 #include <random>
 #include <sstream>
 
@@ -27,6 +31,23 @@ const std::map<std::string, int>& closed_test_meshes() {
 }
 
 TriMesh load_test_mesh(const std::string& name) { return load_mesh_file(data_path(name)); }
+
+const MappedModel& mapped_model(const std::string& name) {
+  static std::mutex mutex;
+  static std::map<std::string, std::unique_ptr<MappedModel>> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  std::unique_ptr<MappedModel>& slot = cache[name];
+  if (!slot) {
+    auto built = std::make_unique<MappedModel>();
+    if (name == "generated-genus-5") built->model = make_genus_surface(5, 40);
+    else if (name == "rocker-arm.obj") built->model = load_mesh_file(example_path(name));
+    else built->model = load_test_mesh(name);
+    built->polycube = build_polycube(built->model, analyse_topology(built->model));
+    built->map = build_polycube_map(built->model, built->polycube);
+    slot = std::move(built);
+  }
+  return *slot;
+}
 
 std::string test_name_of_file(const std::string& file) {
   std::string name = file.substr(0, file.find('.'));

@@ -3,12 +3,24 @@
 #pragma once
 
 #include "polycube/mesh.h"
+#include "polycube/polycube_build.h"
+#include "polycube/polycube_map.h"
 
 #include <map>
 #include <string>
 #include <vector>
 
 namespace polycube::test {
+
+// A model with its stages up to the map (default options, the model's own orientation), built
+// once per name and kept for the test executable's life: "generated-genus-5"
+// (make_genus_surface(5, 40)), a mesh of examples/ ("rocker-arm.obj") or of tests/data.
+struct MappedModel {
+  TriMesh model;
+  PolycubeResult polycube;
+  PolycubeMap map;
+};
+const MappedModel& mapped_model(const std::string& name);
 
 // Absolute path of a file in tests/data/.
 std::string data_path(const std::string& name);
