@@ -183,7 +183,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     nlohmann::json candidates = nlohmann::json::array();
     for (const AlignmentCandidate& c : alignment.candidates)
       candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle},
-                            {"full_budget", c.full_budget}, {"seconds", c.seconds}, {"error", c.error}});
+                            {"fallback_budget", c.fallback_budget}, {"seconds", c.seconds}, {"error", c.error}});
     report["alignment"]["candidates"] = candidates;
     align_seconds = progress.elapsed_seconds() - align_start;
     if (alignment.chosen >= 0) {

@@ -173,46 +173,65 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   const char* principal_names[3] = {"principal axes, least-spread axis up", "principal axes, longest axis up",
                                     "principal axes, middle axis up"};
   const char* normal_names[3] = {"normal axes, z up", "normal axes, x up", "normal axes, y up"};
-  // The normals' frame only when the faces align with it markedly (misalignment below 0.12: CAD
-  // parts 0.06–0.11 on the shipped meshes, organic ones 0.13–0.20, 0.2 for normals spread evenly)
-  // and it is neither of the others (a CAD part in its own frame, or a box, already has it).
+  // The normals' frame when the faces align with it markedly (misalignment below 0.12: CAD parts
+  // 0.06–0.11 on the shipped meshes, organic ones 0.13–0.20, 0.2 for normals spread evenly), and
+  // otherwise in reserve: tried only when no other candidate passes the scoring budget. Never when
+  // it is one of the others (a CAD part in its own frame, or a box, already has it).
   double misalignment = 0;
   const Eigen::Matrix3d normals = normal_axes(mesh, 20000, &misalignment);
-  const bool distinct_normals = misalignment < options.normal_axes_misalignment && !same_axes(normals, Eigen::Matrix3d::Identity()) &&
-                                !same_axes(normals, pca);
-  for (int frame = 0; frame < (distinct_normals ? 3 : 2); ++frame)
+  const bool distinct_normals = !same_axes(normals, Eigen::Matrix3d::Identity()) && !same_axes(normals, pca);
+  const bool reserve_normals = distinct_normals && !(misalignment < options.normal_axes_misalignment);
+  auto add_frame = [&](int frame) {
     for (int k = 0; k < 3; ++k) {
       AlignmentCandidate c;
       c.name = frame == 0 ? input_names[k] : frame == 1 ? principal_names[k] : normal_names[k];
       c.rotation = cycles[k] * (frame == 0 ? Eigen::Matrix3d::Identity() : frame == 1 ? pca : normals);
       out.candidates.push_back(c);
     }
+  };
+  add_frame(0);
+  add_frame(1);
+  if (distinct_normals && !reserve_normals) add_frame(2);
   PolycubeOptions scoring = polycube;
   scoring.max_rounds = std::min(scoring.max_rounds, options.max_rounds);
   scoring.max_inserted_planes = std::min(scoring.max_inserted_planes, options.max_inserted_planes);
   scoring.max_plane_cells = std::min(scoring.max_plane_cells, options.max_plane_cells);
   scoring.max_repair_level = std::min(scoring.max_repair_level, options.max_repair_level);
+  std::vector<std::shared_ptr<TopologyResult>> topologies;
+  std::vector<std::shared_ptr<PolycubeResult>> polycubes;
+  std::vector<TriMesh> turned;
+  // Topology and polycube, under the scoring budget, of candidates [first, end).
+  auto score = [&](int first) {
+    const int end = static_cast<int>(out.candidates.size());
+    topologies.resize(end);
+    polycubes.resize(end);
+    turned.resize(end);
+    std::vector<int> order(end - first);
+    std::iota(order.begin(), order.end(), first);
+    parallel_for_each(order, options.threads, "orientation", [&](int i) {
+      AlignmentCandidate& c = out.candidates[i];
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        turned[i] = rotated(mesh, c.rotation);
+        topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
+        polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], scoring));
+        c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
+      } catch (const Error& e) {
+        c.error = e.what();
+        topologies[i].reset();
+        polycubes[i].reset();
+      }
+      c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    });
+  };
+  score(0);
+  auto any_passed = [&]() { return std::any_of(polycubes.begin(), polycubes.end(), [](const auto& p) { return p != nullptr; }); };
+  if (!any_passed() && reserve_normals) {
+    const int first = static_cast<int>(out.candidates.size());
+    add_frame(2);
+    score(first);
+  }
   const int n = static_cast<int>(out.candidates.size());
-  std::vector<std::shared_ptr<TopologyResult>> topologies(n);
-  std::vector<std::shared_ptr<PolycubeResult>> polycubes(n);
-  std::vector<TriMesh> turned(n);
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  parallel_for_each(order, options.threads, "orientation", [&](int i) {
-    AlignmentCandidate& c = out.candidates[i];
-    const auto start = std::chrono::steady_clock::now();
-    try {
-      turned[i] = rotated(mesh, c.rotation);
-      topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
-      polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], scoring));
-      c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
-    } catch (const Error& e) {
-      c.error = e.what();
-      topologies[i].reset();
-      polycubes[i].reset();
-    }
-    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  });
   // The few with the fewest corners get their map built and audited (vertex-sampled flips both
   // ways, ε_angle): corners alone do not tell a good map from a bad one.
   std::vector<int> mapped;
@@ -255,20 +274,36 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     if (out.chosen < 0 || key(i) < key(out.chosen)) out.chosen = i;
   }
   if (out.chosen < 0 && options.full_budget_fallback) {
-    // Nothing passed the small budget: the full one, candidate by candidate, the first that builds.
-    for (int i = 0; i < n && out.chosen < 0; ++i) {
+    // Nothing passed the scoring budget: four times that budget for every candidate at once (the
+    // one with the fewest corners wins), then the caller's full budget candidate by candidate, the
+    // first that builds. (The full budget alone can take minutes per candidate that fails.)
+    PolycubeOptions larger = polycube;
+    larger.max_rounds = std::min(polycube.max_rounds, 4 * scoring.max_rounds);
+    larger.max_inserted_planes = std::min(polycube.max_inserted_planes, 4 * scoring.max_inserted_planes);
+    larger.max_plane_cells = std::min(polycube.max_plane_cells, 4 * scoring.max_plane_cells);
+    larger.max_repair_level = std::min(polycube.max_repair_level, scoring.max_repair_level + 3);
+    auto build = [&](int i, const PolycubeOptions& budget) {
       AlignmentCandidate& c = out.candidates[i];
       const auto start = std::chrono::steady_clock::now();
       try {
         if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
-        polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], polycube));
+        polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], budget));
         c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
-        c.full_budget = true;
-        out.chosen = i;
+        c.fallback_budget = true;
       } catch (const Error& e) {
         c.error = e.what();
+        polycubes[i].reset();
       }
       c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    std::vector<int> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    parallel_for_each(all, options.threads, "orientation", [&](int i) { build(i, larger); });
+    for (int i = 0; i < n; ++i)
+      if (polycubes[i] && (out.chosen < 0 || out.candidates[i].corners < out.candidates[out.chosen].corners)) out.chosen = i;
+    for (int i = 0; i < n && out.chosen < 0; ++i) {
+      build(i, polycube);
+      if (polycubes[i]) out.chosen = i;
     }
   }
   if (out.chosen >= 0) {

@@ -1,12 +1,14 @@
 // Auto-orientation (the paper's limitation 1: its polycube depends on how the model is turned).
 // Candidates are the input frame, the model's principal axes and the frame its surface normals
-// align with best (normal_axes; only when they align markedly, as a CAD part's do, and it is not
-// one of the other two), each with each of its
+// align with best (normal_axes; when they align markedly, as a CAD part's do; otherwise only when
+// no other candidate passes the scoring budget; never when it is one of the other two), each with
+// each of its
 // three axes as the sweep direction z. Each gets its polycube (under a small repair budget); the
 // few with the fewest corners also get their map, and the map with the fewest flipped image
 // triangles (then the least ε_angle, then the fewest corners) wins. When no candidate passes the
-// budget, they are tried again in order with the caller's full budget, and the first that builds
-// wins (an invalid polycube is never returned: build_polycube throws instead).
+// budget, they are tried again with four times the budget, then in order with the caller's full
+// budget, and the first that builds wins (an invalid polycube is never returned: build_polycube
+// throws instead).
 #pragma once
 
 #include "polycube/mesh.h"
@@ -25,15 +27,15 @@ namespace polycube {
 // One orientation tried: x_aligned = rotation * x_input (a proper rotation).
 //   corners  of the polycube built in it (-1 if the stages failed there, see error)
 //   flipped, eps_angle  of its map before smoothing, both directions (-1 if not mapped)
-//   full_budget  its polycube was built by the full-budget fallback (no candidate passed the
-//            scoring budget)
+//   fallback_budget  its polycube was built by the fallback (no candidate passed the scoring
+//            budget): four times that budget, or the caller's full one
 struct AlignmentCandidate {
   std::string name;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   int corners = -1;
   int flipped = -1;
   double eps_angle = -1;
-  bool full_budget = false;
+  bool fallback_budget = false;
   double seconds = 0;
   std::string error;
 };
@@ -87,8 +89,9 @@ struct AlignmentOptions {
   int mapped_candidates = 3;
   // The normals' frame is a candidate when its misalignment (normal_axes) is below this.
   double normal_axes_misalignment = 0.12;
-  // When no candidate passes the scoring budget, build them again with the full budget, in order,
-  // until one succeeds (then chosen is that one, with its topology and polycube but no map).
+  // When no candidate passes the scoring budget, build them all again with four times that budget
+  // (the fewest corners win) and, if none passes, with the caller's full budget, in order, until
+  // one succeeds (chosen is then that one, with its topology and polycube but no map).
   bool full_budget_fallback = true;
 };
 
