@@ -185,6 +185,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle},
                             {"fallback_budget", c.fallback_budget}, {"seconds", c.seconds}, {"error", c.error}});
     report["alignment"]["candidates"] = candidates;
+    report["alignment"]["proxy_faces"] = alignment.proxy_faces;
+    if (alignment.proxy_faces > 0)
+      progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
     align_seconds = progress.elapsed_seconds() - align_start;
     if (alignment.chosen >= 0) {
       rotation = alignment.rotation;

@@ -189,6 +189,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       const double align_start = progress.elapsed_seconds();
       alignment = choose_alignment(model, options.topology, options.polycube, align_options);
       seconds["align"] = progress.elapsed_seconds() - align_start;
+      if (alignment.proxy_faces > 0)
+        progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
       if (alignment.chosen < 0)
         throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
       rotation = alignment.rotation;

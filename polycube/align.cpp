@@ -3,6 +3,7 @@
 #include "polycube/errors.h"
 #include "polycube/map_audit.h"
 #include "polycube/parallel.h"
+#include "polycube/simplify.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -165,6 +166,15 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
                            const AlignmentOptions& options) {
   Alignment out;
   const Eigen::Matrix3d pca = principal_axes(mesh);
+  // A large model is scored on a coarser copy (same topology); the winner's stages are then built
+  // on the model itself.
+  TriMesh proxy;
+  const bool use_proxy = options.proxy_above > 0 && mesh.num_faces() > options.proxy_above;
+  if (use_proxy) {
+    proxy = simplified_mesh(mesh, options.proxy_faces);
+    out.proxy_faces = proxy.num_faces();
+  }
+  const TriMesh& scored = use_proxy ? proxy : mesh;
   // Cyclic permutations keep the handedness: which frame axis becomes z.
   const Eigen::Matrix3d cycles[3] = {Eigen::Matrix3d::Identity(),
                                      (Eigen::Matrix3d() << 0, 1, 0, 0, 0, 1, 1, 0, 0).finished(),
@@ -212,7 +222,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       AlignmentCandidate& c = out.candidates[i];
       const auto start = std::chrono::steady_clock::now();
       try {
-        turned[i] = rotated(mesh, c.rotation);
+        turned[i] = rotated(scored, c.rotation);
         topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
         polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], scoring));
         c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
@@ -306,7 +316,32 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       if (polycubes[i]) out.chosen = i;
     }
   }
-  if (out.chosen >= 0) {
+  if (out.chosen >= 0 && use_proxy) {
+    // Scored on the coarse copy: the stages of the model itself, in the order of the scoring (the
+    // fallback's choice first), with the caller's budget; the first orientation that builds wins.
+    std::vector<int> ranked;
+    for (int i = 0; i < n; ++i)
+      if (polycubes[i] && i != out.chosen) ranked.push_back(i);
+    std::stable_sort(ranked.begin(), ranked.end(), [&](int a, int b) { return key(a) < key(b); });
+    ranked.insert(ranked.begin(), out.chosen);
+    out.chosen = -1;
+    for (int i : ranked) {
+      AlignmentCandidate& c = out.candidates[i];
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        const TriMesh full = rotated(mesh, c.rotation);
+        auto full_topology = std::make_shared<TopologyResult>(analyse_topology(full, topology));
+        auto full_polycube = std::make_shared<PolycubeResult>(build_polycube(full, *full_topology, polycube));
+        out.topology = std::move(full_topology);
+        out.polycube = std::move(full_polycube);
+        out.chosen = i;
+      } catch (const Error& e) {
+        c.error = std::string("on the model itself: ") + e.what();
+      }
+      c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (out.chosen >= 0) break;
+    }
+  } else if (out.chosen >= 0) {
     out.topology = topologies[out.chosen];
     out.polycube = polycubes[out.chosen];
     out.map = maps[out.chosen];

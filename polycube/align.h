@@ -43,7 +43,8 @@ struct AlignmentCandidate {
 //   chosen     index of the winner, -1 if every candidate failed (within the scoring budget, and
 //              with the full budget when full_budget_fallback is on)
 //   topology, polycube, map  the winner's stages (built on the turned model), so they need not be
-//              redone (map is null when the winner was not mapped)
+//              redone (map is null when the winner was not mapped, or was scored on the proxy)
+//   proxy_faces  faces of the simplified copy the candidates were scored on (0: the model itself)
 struct Alignment {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   int chosen = -1;
@@ -51,6 +52,7 @@ struct Alignment {
   std::shared_ptr<TopologyResult> topology;
   std::shared_ptr<PolycubeResult> polycube;
   std::shared_ptr<PolycubeMap> map;
+  int proxy_faces = 0;
 };
 
 // Principal axes of the surface (area-weighted covariance of the triangles), as the rows of a
@@ -89,6 +91,11 @@ struct AlignmentOptions {
   int mapped_candidates = 3;
   // The normals' frame is a candidate when its misalignment (normal_axes) is below this.
   double normal_axes_misalignment = 0.12;
+  // Models with more faces than proxy_above are scored on a copy simplified to about proxy_faces
+  // faces (simplify.h); the winner's topology and polycube are then built on the model itself
+  // (next best when that fails), without its map. 0: never.
+  int proxy_above = 150000;
+  int proxy_faces = 50000;
   // When no candidate passes the scoring budget, build them all again with four times that budget
   // (the fewest corners win) and, if none passes, with the caller's full budget, in order, until
   // one succeeds (chosen is then that one, with its topology and polycube but no map).

@@ -1,6 +1,8 @@
 // Auto-orientation: principal axes and normal axes of a known box, snapping of aligned models, the
 // candidate scoring keeps a valid winner, and the full-budget fallback.
 #include "polycube/align.h"
+#include "polycube/mesh_topology.h"
+#include "polycube/simplify.h"
 
 #include "support/generated_meshes.h"
 #include "support/test_support.h"
@@ -10,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <stdexcept>
 #include <vector>
 
 namespace polycube {
@@ -112,6 +115,44 @@ TEST(Align, FallsBackToALargerBudget) {
   EXPECT_EQ(static_cast<int>(a.polycube->polycube.corners.size()), w.corners);
   EXPECT_FALSE(a.map);
   EXPECT_EQ(a.rotation, w.rotation);
+}
+
+// A model above the proxy threshold is scored on a simplified copy (same genus); the winner's
+// topology and polycube are of the model itself, its map is left to the caller.
+TEST(Align, LargeModelsAreScoredOnASimplifiedCopy) {
+  const TriMesh model = load_test_mesh("knot.off");  // 4160 faces, genus 1
+  AlignmentOptions options;
+  options.proxy_above = 2000;
+  options.proxy_faces = 1500;
+  const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, options);
+  EXPECT_GT(a.proxy_faces, 1000);
+  EXPECT_LE(a.proxy_faces, 1600);
+  ASSERT_GE(a.chosen, 0);
+  ASSERT_TRUE(a.topology);
+  ASSERT_TRUE(a.polycube);
+  EXPECT_FALSE(a.map);
+  EXPECT_EQ(a.polycube->genus, 1);
+  EXPECT_EQ(a.topology->sliced.input_vertices, model.num_vertices()) << "stages of the model itself";
+  EXPECT_EQ(a.rotation, a.candidates[a.chosen].rotation);
+  // Below the threshold: the model itself, mapped.
+  const Alignment b = choose_alignment(model, TopologyOptions{}, PolycubeOptions{});
+  EXPECT_EQ(b.proxy_faces, 0);
+  EXPECT_TRUE(b.map);
+}
+
+// The simplified copy keeps the genus and the single component, and has about the faces asked.
+TEST(Align, SimplifiedMeshKeepsTheTopology) {
+  for (const char* name : {"knot.off", "couplingdown.off", "elk.off"}) {
+    const TriMesh model = load_test_mesh(name);
+    const TriMesh coarse = simplified_mesh(model, 800);
+    const int euler = model.num_vertices() - model.num_faces() / 2;  // V - E + F with E = 3F/2
+    EXPECT_EQ(coarse.num_vertices() - coarse.num_faces() / 2, euler) << name;
+    EXPECT_EQ(connected_components(coarse.F, coarse.num_vertices()), 1) << name;
+    EXPECT_LE(coarse.num_faces(), 900) << name;
+    EXPECT_GE(coarse.num_faces(), 500) << name;
+    EXPECT_EQ(simplified_mesh(coarse, 100000).F, coarse.F) << "a small mesh comes back unchanged";
+  }
+  EXPECT_THROW(simplified_mesh(load_test_mesh("sphere.off"), 2), std::invalid_argument);
 }
 
 // The winner is the mapped candidate with the fewest flipped triangles (then least ε_angle); the
