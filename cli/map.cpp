@@ -178,7 +178,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   double align_seconds = 0;
   if (options.align == "auto" && options.stage != "topology") {
     const double align_start = progress.elapsed_seconds();
-    progress.stage("align", "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 3 with fewest corners, scored by flips");
+    progress.stage("align", "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 2 with fewest corners (the rest if both flip), scored by flips");
     alignment = choose_alignment(prepared.mesh, options.topology, options.polycube);
     nlohmann::json candidates = nlohmann::json::array();
     for (const AlignmentCandidate& c : alignment.candidates)

@@ -184,7 +184,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       AlignmentOptions align_options;
       if (options.align == "corners") align_options.mapped_candidates = 0;
       progress.stage("align", options.align == "auto"
-                                  ? "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 3 with fewest corners, scored by flips"
+                                  ? "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 2 with fewest corners (the rest if both flip), scored by flips"
                                   : "orientations (input frame, principal axes, normal axes): the polycube with the fewest corners");
       const double align_start = progress.elapsed_seconds();
       alignment = choose_alignment(model, options.topology, options.polycube, align_options);

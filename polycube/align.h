@@ -88,7 +88,7 @@ struct AlignmentOptions {
   int max_repair_level = 12;
   // How many candidates (fewest corners first) get their map built and audited first; if all of
   // those still have flipped triangles, the rest are mapped too. 0: corners only.
-  int mapped_candidates = 3;
+  int mapped_candidates = 2;
   // The normals' frame is a candidate when its misalignment (normal_axes) is below this.
   double normal_axes_misalignment = 0.12;
   // Models with more faces than proxy_above are scored on a copy simplified to about proxy_faces
