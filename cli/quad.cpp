@@ -292,7 +292,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                       {"free_loops_removed", grid.free_loops},
                       {"layout_cells", grid.layout.num_quads()},
                       {"chords", grid.chords}};
-    report["smoothing"] = {{"sweeps", result.smoothing.sweeps}, {"moves", result.smoothing.moves}, {"refused", result.smoothing.rejected},
+    report["smoothing"] = {{"sweeps", result.smoothing.sweeps},       {"moves", result.smoothing.moves},
+                           {"refused", result.smoothing.rejected},    {"reverted", result.smoothing.reverted},
                            {"converged", result.smoothing.converged}, {"largest_move", result.smoothing.largest_move}};
     report["fitting"] = {{"passes", result.fitting.passes},
                          {"snapped", result.fitting.snapped},

@@ -82,12 +82,16 @@ class QuadGuard {
 
   // centre: in, the search hint for the quad centre's closest point (face -1: none); out, that
   // point. size: the mean quad size (corners with an edge below kCollapsedEdge of it are free).
-  int state(int q, SurfaceHit& centre, double size) const {
+  // on_sheet: the centre's closest point on the hint's sheet (SurfaceProjector::closest_on_sheet,
+  // fast) instead of on the whole surface (as measure_quads takes it).
+  int state(int q, SurfaceHit& centre, double size, bool on_sheet = false) const {
     int bits = 0;
     Eigen::Vector3d p[4];
     for (int k = 0; k < 4; ++k) p[k] = mesh_.V.row(mesh_.Q(q, k));
     const Eigen::Vector3d middle = (p[0] + p[1] + p[2] + p[3]) / 4;
-    centre = centre.face >= 0 ? surface_.closest(middle, centre) : surface_.closest(middle);
+    centre = centre.face < 0 ? surface_.closest(middle)
+             : on_sheet        ? surface_.closest_on_sheet(middle, centre)
+                               : surface_.closest(middle, centre);
     const Eigen::Vector3d n = quad_surface_normal(surface_, centre);
     // A corner with an edge of (almost) no length has no meaningful turn: it is not held, so
     // vertices a map collapsed onto one point can move apart.
@@ -139,7 +143,36 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   double size = mean_quad_size(mesh);
 
   const QuadGuard guard(mesh, surface);
-  const auto state = [&](int q, SurfaceHit& centre) { return guard.state(q, centre, size); };
+  // During a sweep the guards of quads far from trouble take the quad centres' closest points on
+  // their sheets (fast); the sweep's end checks every quad against the whole surface (see below).
+  // Quads with a bit unset at the sweep's start, and those within two rings of them, are judged
+  // against the whole surface throughout, so that the moves round a tangle are judged as the
+  // measure judges them and the ones that repair it count as repairs.
+  constexpr int kAllBits = 31;
+  std::vector<int> quad_state(mesh.num_quads());
+  std::vector<char> whole_surface(mesh.num_quads(), 0);
+  const auto state = [&](int q, SurfaceHit& centre) { return guard.state(q, centre, size, !whole_surface[q]); };
+  // Marks the quads with a bit unset and those within two rings of them (sharing a vertex).
+  const auto mark_trouble = [&]() {
+    std::fill(whole_surface.begin(), whole_surface.end(), 0);
+    std::vector<int> front;
+    for (int q = 0; q < mesh.num_quads(); ++q)
+      if (quad_state[q] != kAllBits) {
+        whole_surface[q] = 1;
+        front.push_back(q);
+      }
+    for (int ring = 0; ring < 2; ++ring) {
+      std::vector<int> next;
+      for (int q : front)
+        for (int k = 0; k < 4; ++k)
+          for (int r : around[mesh.Q(q, k)])
+            if (!whole_surface[r]) {
+              whole_surface[r] = 1;
+              next.push_back(r);
+            }
+      front = std::move(next);
+    }
+  };
 
   // The cross at v: its spokes (edges to its neighbours, counter-clockwise in the tangent plane
   // t1, t2 = n × t1) turned to equal angles (90° at a regular vertex) by the best common
@@ -196,8 +229,7 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
     return p + offset.real() * t1 + offset.imag() * t2;
   };
 
-  std::vector<int> quad_state(mesh.num_quads());
-  for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = state(q, quad_hit[q]);
+  for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
 
   // One Gauss–Seidel move of v; returns how far it moved (-1: refused, 0: nothing to do). Reads
   // the vertices of v's quads, writes v and v's quads' states.
@@ -259,8 +291,11 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
     Eigen::Vector3d d = target - p;
     d -= d.dot(n) * n;
     if (!d.allFinite() || d.squaredNorm() == 0) return 0;
+    // Round a tangle the vertex is placed as the measure would place it (on the whole surface).
+    bool near_trouble = false;
+    for (int q : around[v]) near_trouble |= whole_surface[q] != 0;
     for (double step = options.step; step >= options.step / 4; step /= 2) {
-      const SurfaceHit hit = surface.closest(p + step * d, old_hit);
+      const SurfaceHit hit = near_trouble ? surface.closest(p + step * d, old_hit) : surface.closest_on_sheet(p + step * d, old_hit);
       // The closest point must be the surface under the vertex, not another sheet of a thin
       // part (the far side of an ear) that happens to be nearer to the moved point.
       if (!(hit.normal.dot(n) > kSameSheet) || (hit.point - p).norm() > 2 * step * d.norm()) continue;
@@ -307,9 +342,19 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   };
   std::vector<int> parts(threads);
   std::iota(parts.begin(), parts.end(), 0);
+  // The sweep's start, for its end's check.
+  Eigen::MatrixX3d start_V;
+  std::vector<SurfaceHit> start_vertex_hit, start_quad_hit, checked_hit(mesh.num_quads());
+  std::vector<int> start_quad_state, checked_state(mesh.num_quads()), all_quads(mesh.num_quads());
+  std::iota(all_quads.begin(), all_quads.end(), 0);
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     ++result.sweeps;
     size = mean_quad_size(mesh);
+    start_V = mesh.V;
+    start_vertex_hit = vertex_hit;
+    start_quad_hit = quad_hit;
+    start_quad_state = quad_state;
+    mark_trouble();
     std::vector<Tally> tally(threads);
     for (const std::vector<int>& colour : colours) {
       const auto run = [&](int part) {
@@ -329,6 +374,43 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
       } else {
         parallel_for_each(parts, threads, "part", run);
       }
+    }
+    // The end of the sweep: every quad judged against the whole surface, as measure_quads judges
+    // it (a quad across a thin part can be nearer the far sheet than its own). Where a quad lost
+    // a bit it had at the sweep's start, its moved corners go back to their start; the quads
+    // round them are judged again, until none lost one. Quads whose corners are all back have
+    // their start state again, so this ends, at worst with the sweep's start.
+    const auto judge = [&](int q) {
+      checked_hit[q] = start_quad_hit[q];
+      checked_state[q] = guard.state(q, checked_hit[q], size);
+    };
+    parallel_for_each(all_quads, threads, "quad", judge);
+    std::vector<int> lost;
+    for (int q = 0; q < mesh.num_quads(); ++q)
+      if (start_quad_state[q] & ~checked_state[q]) lost.push_back(q);
+    std::vector<char> touched(mesh.num_quads(), 0);
+    while (!lost.empty()) {
+      std::vector<int> again;
+      for (int q : lost)
+        for (int k = 0; k < 4; ++k) {
+          const int v = mesh.Q(q, k);
+          if (mesh.V.row(v) == start_V.row(v)) continue;
+          mesh.V.row(v) = start_V.row(v);
+          vertex_hit[v] = start_vertex_hit[v];
+          ++result.reverted;
+          for (int r : around[v]) again.push_back(r);
+        }
+      std::sort(again.begin(), again.end());
+      again.erase(std::unique(again.begin(), again.end()), again.end());
+      lost.clear();
+      for (int q : again) {
+        judge(q);
+        if (start_quad_state[q] & ~checked_state[q]) lost.push_back(q);
+      }
+    }
+    for (int q = 0; q < mesh.num_quads(); ++q) {
+      quad_state[q] = checked_state[q];
+      quad_hit[q] = checked_hit[q];
     }
     double largest = 0;
     for (const Tally& t : tally) {

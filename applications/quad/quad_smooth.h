@@ -45,7 +45,8 @@ struct QuadSmoothOptions {
 // What happened.
 //   mesh      the relaxed quads (same connectivity), every vertex that moved on the surface
 //   sweeps    sweeps run; converged: the last one moved less than the tolerance
-//   moves     accepted vertex moves; rejected: moves refused at every tried length
+//   moves     accepted vertex moves; rejected: moves refused at every tried length; reverted:
+//             accepted moves undone at the end of their sweep (see smooth_quads)
 //   largest_move  of the last sweep, over the mean quad size
 //   seconds   wall time
 struct QuadSmoothResult {
@@ -54,6 +55,7 @@ struct QuadSmoothResult {
   bool converged = false;
   long long moves = 0;
   long long rejected = 0;
+  long long reverted = 0;  // vertex moves undone by the sweeps' end checks
   double largest_move = 0;
   double seconds = 0;
 };
@@ -71,6 +73,9 @@ struct QuadSmoothResult {
 // with an edge below 0.1 % of the mean quad size (both ends sent to about one point by the map: a
 // degenerate or nearly degenerate quad) is not held, so collapsed vertices can move apart (the
 // quad's diagonal test still is).
+// Within a sweep the moves are judged against the quads' surface normals found on their own sheet
+// (fast walks); at its end every quad is judged against the whole surface, as measure_quads
+// judges it, and the moves of the sweep that lost a quad a bit there are undone (reverted).
 // pinned (empty, or one flag per vertex): vertices that do not move (fit_quads' snapped ones).
 // Throws std::invalid_argument for step outside (0, 2], negative sweeps, weights or tolerance,
 // all weights 0, or pinned flags of the wrong size.

@@ -1,5 +1,8 @@
 #include "applications/quad/surface_projector.h"
 
+#include "polycube/closest_point.h"
+#include "polycube/mesh_topology.h"
+
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/Simple_cartesian.h>
@@ -50,6 +53,10 @@ struct SurfaceProjector::Impl {
   Eigen::MatrixX3d vertex_normals;
   std::vector<Triangle> triangles;
   Tree tree;
+  // For the walks of closest_on_sheet: the face across each edge of a face (-1: none), the faces
+  // round each vertex (CSR).
+  Eigen::MatrixX3i across;
+  std::vector<int> ring_start, ring;
 
   // The hit for a query whose closest point on the surface is `point`, on triangle `face`.
   SurfaceHit hit(const Eigen::Vector3d& query, const Eigen::Vector3d& point, int face) const;
@@ -79,6 +86,22 @@ SurfaceProjector::SurfaceProjector(const TriMesh& surface) : impl_(std::make_uni
   impl_->tree.insert(boost::counting_iterator<int>(0), boost::counting_iterator<int>(surface.num_faces()), &impl_->triangles);
   impl_->tree.build();
   impl_->tree.accelerate_distance_queries();
+  const EdgeMap edges = build_edge_map(surface.F);
+  impl_->across.resize(surface.num_faces(), 3);
+  for (int f = 0; f < surface.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      const int e = edges.FE(f, i);
+      const int other = edges.EF(e, 0) == f ? edges.EF(e, 1) : edges.EF(e, 0);
+      impl_->across(f, i) = edges.face_count[e] == 2 ? other : -1;
+    }
+  impl_->ring_start.assign(surface.num_vertices() + 1, 0);
+  for (int f = 0; f < surface.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) ++impl_->ring_start[surface.F(f, i) + 1];
+  for (int v = 0; v < surface.num_vertices(); ++v) impl_->ring_start[v + 1] += impl_->ring_start[v];
+  impl_->ring.resize(impl_->ring_start.back());
+  std::vector<int> filled(impl_->ring_start.begin(), impl_->ring_start.end() - 1);
+  for (int f = 0; f < surface.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) impl_->ring[filled[surface.F(f, i)]++] = f;
 }
 
 SurfaceProjector::~SurfaceProjector() = default;
@@ -95,6 +118,54 @@ SurfaceHit SurfaceProjector::closest(const Eigen::Vector3d& query, const Surface
   const auto [point, face] =
       impl_->tree.closest_point_and_primitive(q, {Point(hint.point.x(), hint.point.y(), hint.point.z()), hint.face});
   return impl_->hit(query, {point.x(), point.y(), point.z()}, face);
+}
+
+SurfaceHit SurfaceProjector::closest_on_sheet(const Eigen::Vector3d& query, const SurfaceHit& hint) const {
+  const TriMesh& m = impl_->surface;
+  if (hint.face < 0 || hint.face >= m.num_faces()) return closest(query);
+  const auto on_face = [&](int f) {
+    return closest_on_triangle(query, m.V.row(m.F(f, 0)), m.V.row(m.F(f, 1)), m.V.row(m.F(f, 2)));
+  };
+  int face = hint.face;
+  TriangleClosest best = on_face(face);
+  double best_distance = (best.point - query).squaredNorm();
+  // Each step gets strictly nearer, so no face is visited twice.
+  for (int step = 0; step < m.num_faces(); ++step) {
+    int zeros = 0, zero = -1, nonzero = -1;
+    for (int i = 0; i < 3; ++i) {
+      if (best.bary[i] <= 0) {
+        ++zeros;
+        zero = i;
+      } else {
+        nonzero = i;
+      }
+    }
+    if (zeros == 0) break;  // inside the face: a local minimum
+    int next = -1;
+    TriangleClosest next_closest;
+    double next_distance = best_distance * (1 - 1e-12);
+    const auto consider = [&](int g) {
+      if (g < 0 || g == face) return;
+      const TriangleClosest c = on_face(g);
+      const double d = (c.point - query).squaredNorm();
+      if (d < next_distance) {
+        next = g;
+        next_closest = c;
+        next_distance = d;
+      }
+    };
+    if (zeros == 1) {
+      consider(impl_->across(face, (zero + 1) % 3));  // on the edge opposite corner `zero`
+    } else {
+      const int v = m.F(face, nonzero);  // at that corner
+      for (int k = impl_->ring_start[v]; k < impl_->ring_start[v + 1]; ++k) consider(impl_->ring[k]);
+    }
+    if (next < 0) break;
+    face = next;
+    best = next_closest;
+    best_distance = next_distance;
+  }
+  return impl_->hit(query, best.point, face);
 }
 
 SurfaceHit SurfaceProjector::Impl::hit(const Eigen::Vector3d& query, const Eigen::Vector3d& point, int face) const {

@@ -277,7 +277,9 @@ TEST(QuadCarry, FitPullsACornerOntoATip) {
   for (int v = 0; v < fit.mesh.num_vertices(); ++v) on_tip |= fit.mesh.V.row(v) == spiked.V.row(tip);
   EXPECT_TRUE(on_tip) << "a corner sits on the tip";
   for (int v = 0; v < fit.mesh.num_vertices(); ++v) {
-    if (!fit.pinned[v]) EXPECT_EQ(fit.mesh.V.row(v), quads.V.row(v)) << "only pulled vertices move";
+    if (!fit.pinned[v]) {
+      EXPECT_EQ(fit.mesh.V.row(v), quads.V.row(v)) << "only pulled vertices move";
+    }
   }
   const QuadQuality after = measure_quads(fit.mesh, model, c.grid.corners);
   EXPECT_EQ(after.flipped_quads, 0);
@@ -291,7 +293,9 @@ TEST(QuadCarry, FitPullsACornerOntoATip) {
   options.sweeps = 5;
   const QuadSmoothResult relaxed = smooth_quads(fit.mesh, model, options, fit.pinned);
   for (int v = 0; v < fit.mesh.num_vertices(); ++v) {
-    if (fit.pinned[v]) EXPECT_EQ(relaxed.mesh.V.row(v), fit.mesh.V.row(v));
+    if (fit.pinned[v]) {
+      EXPECT_EQ(relaxed.mesh.V.row(v), fit.mesh.V.row(v));
+    }
   }
   EXPECT_THROW(smooth_quads(fit.mesh, model, options, std::vector<char>(3, 0)), std::invalid_argument);
   QuadFitOptions bad;

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -92,6 +93,71 @@ TEST(QuadSmooth, UntanglesFoldedQuadsOfATangledMap) {
   EXPECT_LT(after.quality.inverted_corners, before.quality.inverted_corners / 2)
       << before.quality.inverted_corners << " -> " << after.quality.inverted_corners;
   EXPECT_LT(after.quality.angle_deviation_mean, before.quality.angle_deviation_mean);
+}
+
+// The box [0, 1] x [0, 1] x [0, thickness], outward-oriented triangles.
+TriMesh thin_box(double thickness) {
+  TriMesh box;
+  box.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i) box.V.row(i) << (i & 1), (i >> 1 & 1), (i >> 2 & 1) * thickness;
+  box.F.resize(12, 3);
+  box.F << 0, 2, 1, 1, 2, 3,  // bottom (z = 0), facing down
+      4, 5, 6, 5, 7, 6,       // top
+      0, 1, 4, 1, 5, 4,       // y = 0
+      2, 6, 3, 3, 6, 7,       // y = 1
+      0, 4, 2, 2, 4, 6,       // x = 0
+      1, 3, 5, 3, 7, 5;       // x = 1
+  return box;
+}
+
+TEST(SurfaceProjector, WalkOnASheetMatchesTheTreeNearTheSurface) {
+  // Points a little off a model, walked to from the closest point of a vertex nearby. On a convex
+  // model the walk finds what the tree finds; elsewhere it can stop on its face where a concave
+  // edge has the nearer point on the other face, never nearer than the tree (the true minimum).
+  for (const char* name : {"sphere.off", "elk.off"}) {
+    const TriMesh model = test::load_test_mesh(name);
+    const SurfaceProjector projector(model);
+    const double diagonal = bounding_box(model.V).diagonal();
+    int compared = 0, same = 0;
+    for (int v = 0; v < model.num_vertices(); v += 3) {
+      const Eigen::Vector3d p = model.V.row(v);
+      const SurfaceHit at = projector.closest(p);
+      const Eigen::Vector3d offset(std::sin(1.7 * v), std::cos(2.3 * v), std::sin(0.9 * v + 1));
+      const Eigen::Vector3d query = p + 1e-3 * diagonal * (at.normal + offset.normalized());
+      const SurfaceHit tree = projector.closest(query);
+      const SurfaceHit walk = projector.closest_on_sheet(query, at);
+      EXPECT_GE(walk.distance, tree.distance - 1e-12 * diagonal) << name << " vertex " << v;
+      EXPECT_NEAR(walk.distance, (walk.point - query).norm(), 1e-12 * diagonal);
+      same += (walk.point - tree.point).norm() <= 1e-9 * diagonal;
+      ++compared;
+    }
+    EXPECT_GT(compared, 50) << name;
+    if (std::string(name) == "sphere.off") {
+      EXPECT_EQ(same, compared) << name;
+    } else {
+      EXPECT_GT(same, 0.9 * compared) << name;
+    }
+    const SurfaceHit none = projector.closest_on_sheet(model.V.row(0).transpose(), SurfaceHit{});
+    EXPECT_GE(none.face, 0) << "no hint: the tree";
+  }
+}
+
+TEST(SurfaceProjector, WalkStaysOnItsSheetOfAThinPart) {
+  const SurfaceProjector box(thin_box(0.01));
+  const SurfaceHit bottom = box.closest(Eigen::Vector3d(0.5, 0.5, -0.001));
+  ASSERT_LT(box.face_normal(bottom.face).z(), -0.99);
+  // Nearer the top sheet than the bottom one.
+  const Eigen::Vector3d query(0.52, 0.49, 0.009);
+  const SurfaceHit tree = box.closest(query);
+  const SurfaceHit walk = box.closest_on_sheet(query, bottom);
+  EXPECT_GT(box.face_normal(tree.face).z(), 0.99) << "the tree takes the top";
+  EXPECT_LT(box.face_normal(walk.face).z(), -0.99) << "the walk stays on the bottom";
+  EXPECT_NEAR(walk.distance, 0.009, 1e-12);
+  EXPECT_NEAR(walk.point.x(), 0.52, 1e-12);
+  EXPECT_NEAR(walk.point.y(), 0.49, 1e-12);
+  // Across the bottom's diagonal and round its corner, the walk follows the sheet.
+  const SurfaceHit corner = box.closest_on_sheet(Eigen::Vector3d(-0.2, -0.3, -0.001), bottom);
+  EXPECT_NEAR((corner.point - Eigen::Vector3d(0, 0, 0)).norm(), 0, 1e-3) << corner.point.transpose();
 }
 
 TEST(QuadSmooth, StopsWhenConvergedAndChecksOptions) {
