@@ -993,6 +993,8 @@ struct PhaseResult {
   bool found = false;  // a round no worse than the start in either direction
 };
 
+bool same_point(const SurfacePoint& a, const SurfacePoint& b) { return a.face == b.face && a.bary == b.bary; }
+
 PhaseResult run_phase(const PhaseInput& in, const MapSmoothingOptions& options) {
   const TriMesh& S = in.source->mesh();
   const TriMesh& T = in.target->mesh();
@@ -1001,6 +1003,9 @@ PhaseResult run_phase(const PhaseInput& in, const MapSmoothingOptions& options) 
   int best_flips = -1;
   std::vector<char> frozen = in.frozen;
   const int rounds = in.untangle ? std::min(options.rounds, kUntangleRounds) : options.rounds;
+  // The previous round's end (its images and flags), for judging only what a round changed.
+  std::vector<SurfacePoint> last_on_target, last_on_source;
+  std::vector<char> last_flipped_f, last_flipped_b;
   for (int round = 0; round < rounds; ++round) {
     ForwardMap forward(*in.target, S, *in.fans, in.on_target);
     forward.freeze(frozen);
@@ -1018,14 +1023,24 @@ PhaseResult run_phase(const PhaseInput& in, const MapSmoothingOptions& options) 
     result.on_source = locate_model_vertices(*in.target, *in.source, result.on_target, forward.moved(), in.on_source, options.threads,
                                              missed, result.relocated);
     result.on_source_xyz = positions(S, result.on_source);
-    // Only triangles with a corner whose image changed are judged again.
-    std::vector<char> moved_target(T.num_vertices(), 0);
-    for (int w = 0; w < T.num_vertices(); ++w)
-      moved_target[w] = result.on_source[w].face != in.on_source[w].face || result.on_source[w].bary != in.on_source[w].bary;
-    const std::vector<char> flipped_f =
-        in.target_audit->flipped(S.F, result.on_target_xyz, &result.on_target, options.threads, &in.flipped_forward, &forward.moved());
-    const std::vector<char> flipped_b =
-        in.source_audit->flipped(T.F, result.on_source_xyz, &result.on_source, options.threads, &in.flipped_backward, &moved_target);
+    // Only triangles with a corner whose image changed are judged again: since the phase's start
+    // in the first round, since the previous round's end in the later ones (a triangle's flag
+    // depends on its corners' images alone; later rounds differ from the previous one only round
+    // the vertices frozen since).
+    const bool from_start = round == 0;
+    const std::vector<SurfacePoint>& forward_base = from_start ? in.on_target : last_on_target;
+    const std::vector<SurfacePoint>& backward_base = from_start ? in.on_source : last_on_source;
+    std::vector<char> moved_source(S.num_vertices(), 0), moved_target(T.num_vertices(), 0);
+    for (int v = 0; v < S.num_vertices(); ++v) moved_source[v] = !same_point(result.on_target[v], forward_base[v]);
+    for (int w = 0; w < T.num_vertices(); ++w) moved_target[w] = !same_point(result.on_source[w], backward_base[w]);
+    const std::vector<char> flipped_f = in.target_audit->flipped(S.F, result.on_target_xyz, &result.on_target, options.threads,
+                                                                 from_start ? &in.flipped_forward : &last_flipped_f, &moved_source);
+    const std::vector<char> flipped_b = in.source_audit->flipped(T.F, result.on_source_xyz, &result.on_source, options.threads,
+                                                                 from_start ? &in.flipped_backward : &last_flipped_b, &moved_target);
+    last_on_target = result.on_target;
+    last_on_source = result.on_source;
+    last_flipped_f = flipped_f;
+    last_flipped_b = flipped_b;
     result.frozen = count(frozen);
     result.rounds = round + 1;
     result.flipped = {count(flipped_f), count(flipped_b)};
