@@ -467,8 +467,9 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   command->add_option("--align", options->align,
-                      "auto: try the input frame and the principal axes, each axis as the sweep direction, keep the polycube with the "
-                      "fewest corners; none: keep the input's orientation")
+                      "auto: try the input frame, the principal axes and (for CAD-like parts) the normals' frame, each axis as the "
+                      "sweep direction; map the two polycubes with the fewest corners (all, when both flip) and keep the map with the "
+                      "fewest flipped triangles; none: keep the input's orientation")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "none"}));
   command->add_option("--smooth-sweeps", options->smooth_sweeps,
