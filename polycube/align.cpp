@@ -207,6 +207,14 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   scoring.max_inserted_planes = std::min(scoring.max_inserted_planes, options.max_inserted_planes);
   scoring.max_plane_cells = std::min(scoring.max_plane_cells, options.max_plane_cells);
   scoring.max_repair_level = std::min(scoring.max_repair_level, options.max_repair_level);
+  // One factorised Laplacian for every candidate's harmonic function (they are turned copies of
+  // one mesh); a mesh it cannot be built for fails in each candidate as before.
+  std::unique_ptr<HarmonicSolver> harmonic;
+  try {
+    harmonic = std::make_unique<HarmonicSolver>(scored, topology.harmonic);
+  } catch (const Error&) {
+    harmonic.reset();
+  }
   std::vector<std::shared_ptr<TopologyResult>> topologies;
   std::vector<std::shared_ptr<PolycubeResult>> polycubes;
   std::vector<TriMesh> turned;
@@ -223,7 +231,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       const auto start = std::chrono::steady_clock::now();
       try {
         turned[i] = rotated(scored, c.rotation);
-        topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
+        topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology, harmonic.get()));
         polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], scoring));
         c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
       } catch (const Error& e) {
@@ -296,7 +304,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       AlignmentCandidate& c = out.candidates[i];
       const auto start = std::chrono::steady_clock::now();
       try {
-        if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology));
+        if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology, harmonic.get()));
         polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], budget));
         c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
         c.fallback_budget = true;

@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -124,6 +126,141 @@ HarmonicFunction harmonic_function(const TriMesh& mesh, const HarmonicOptions& o
     for (int v = 0; v < nv; ++v)
       if (unknown[v] >= 0) result.f[v] = x[unknown[v]];
   }
+  return result;
+}
+
+struct HarmonicSolver::Impl {
+  Eigen::MatrixX3i F;
+  int nv = 0;
+  IntrinsicTriangulation intrinsic;
+  int negative_weights = 0;
+  int raised_weights = 0;
+  int refinement_steps = 0;
+  // Each edge once: its ends and weight (raised as harmonic_function raises it).
+  std::vector<std::pair<int, int>> edges;
+  std::vector<double> weights;
+  // The Laplacian without row and column `ground` (vertex v > ground is unknown v − 1), lower
+  // triangle, and its factorisation.
+  int ground = 0;
+  Eigen::SparseMatrix<double> L;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> solver;
+  mutable std::mutex mutex;
+};
+
+HarmonicSolver::HarmonicSolver(const TriMesh& mesh, const HarmonicOptions& options) : impl_(std::make_unique<Impl>()) {
+  const int nv = mesh.num_vertices();
+  if (nv < 3 || mesh.num_faces() == 0) throw MeshError("harmonic_function: empty mesh");
+  if (const int unused = count_unreferenced_vertices(mesh.F, nv); unused > 0)
+    throw MeshError("harmonic_function: " + std::to_string(unused) + " vertices are used by no face");
+  if (const int components = connected_components(mesh.F, nv); components != 1)
+    throw MeshError("harmonic_function: mesh must be connected, got " + std::to_string(components) + " components");
+  Impl& m = *impl_;
+  m.F = mesh.F;
+  m.nv = nv;
+  m.refinement_steps = options.refinement_steps;
+  const double extent = bounding_box(mesh.V).extent().maxCoeff();
+  if (!(extent > 0)) throw MeshError("harmonic_function: mesh has no extent");
+  const TriMesh unit{mesh.V / extent, mesh.F};
+  IntrinsicDelaunayOptions idt;
+  if (!options.intrinsic_delaunay) idt.max_flips_per_edge = 0;
+  m.intrinsic = intrinsic_delaunay(unit, idt);
+  const IntrinsicTriangulation& T = m.intrinsic;
+  Eigen::MatrixX3d half_weight(T.F.rows(), 3);
+  for (int f = 0; f < T.F.rows(); ++f)
+    for (int i = 0; i < 3; ++i)
+      half_weight(f, i) = half_cotan_opposite(T.length(f, i), T.length(f, (i + 1) % 3), T.length(f, (i + 2) % 3));
+  const double mean_weight = half_weight.sum() / (1.5 * T.F.rows());
+  const double weight_floor = options.intrinsic_delaunay ? options.min_weight * mean_weight
+                                                         : -std::numeric_limits<double>::infinity();
+  for (int f = 0; f < T.F.rows(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      const int g = T.adjacent(f, i), j = T.adjacent_edge(f, i);
+      if (g < f || (g == f && j < i)) continue;  // each edge once
+      double w = half_weight(f, i) + half_weight(g, j);
+      if (w < -1e-10 * mean_weight) ++m.negative_weights;
+      if (w < weight_floor) {
+        w = weight_floor;
+        ++m.raised_weights;
+      }
+      m.edges.emplace_back(T.F(f, i), T.F(f, (i + 1) % 3));
+      m.weights.push_back(w);
+    }
+  const int n = nv - 1;
+  auto unknown = [&m](int v) { return v < m.ground ? v : v == m.ground ? -1 : v - 1; };
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(m.edges.size() + n);
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
+  for (size_t e = 0; e < m.edges.size(); ++e) {
+    const int ua = unknown(m.edges[e].first), ub = unknown(m.edges[e].second);
+    const double w = m.weights[e];
+    if (ua >= 0) diagonal[ua] += w;
+    if (ub >= 0) diagonal[ub] += w;
+    if (ua >= 0 && ub >= 0 && ua != ub) triplets.emplace_back(std::max(ua, ub), std::min(ua, ub), -w);
+  }
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, diagonal[i]);
+  m.L.resize(n, n);
+  m.L.setFromTriplets(triplets.begin(), triplets.end());
+  m.solver.compute(m.L);
+  if (m.solver.info() != Eigen::Success)
+    throw AlgorithmError("harmonic_function: Cholesky factorisation of the grounded " + std::to_string(n) + " x " +
+                         std::to_string(n) + " Laplacian failed");
+}
+
+HarmonicSolver::~HarmonicSolver() = default;
+
+HarmonicFunction HarmonicSolver::solve(const TriMesh& moved) const {
+  const Impl& m = *impl_;
+  if (moved.num_vertices() != m.nv || moved.F.rows() != m.F.rows() || moved.F != m.F)
+    throw std::invalid_argument("HarmonicSolver::solve: the mesh's faces or vertex count differ from the solver's");
+  HarmonicFunction result;
+  extreme_vertices(moved.V, result.source, result.sink);
+  if (!(moved.V(result.sink, 2) > moved.V(result.source, 2)))
+    throw MeshError("harmonic_function: mesh has no height (all z equal)");
+  const int n = m.nv - 1;
+  auto unknown = [&m](int v) { return v < m.ground ? v : v == m.ground ? -1 : v - 1; };
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  if (unknown(result.sink) >= 0) rhs[unknown(result.sink)] += 1;
+  if (unknown(result.source) >= 0) rhs[unknown(result.source)] -= 1;
+  Eigen::VectorXd x;
+  {
+    const std::lock_guard<std::mutex> lock(m.mutex);
+    x = m.solver.solve(rhs);
+    const auto full = m.L.selfadjointView<Eigen::Lower>();
+    for (int step = 0; step < m.refinement_steps; ++step) {
+      const Eigen::VectorXd r = rhs - full * x;
+      x += m.solver.solve(r);
+    }
+  }
+  if (!x.allFinite()) throw AlgorithmError("harmonic_function: the Laplace solve produced non-finite values");
+  Eigen::VectorXd u(m.nv);
+  for (int v = 0; v < m.nv; ++v) u[v] = unknown(v) >= 0 ? x[unknown(v)] : 0.0;
+  const double low = u[result.source], span = u[result.sink] - low;
+  if (!(span > 0)) throw AlgorithmError("harmonic_function: the dipole solve gave no rise from source to sink");
+  result.f = (u.array() - low) / span;
+  result.f[result.source] = 0;
+  result.f[result.sink] = 1;
+  // The Dirichlet problem's residual at the free vertices, relative to its right-hand side (the
+  // weights into the sink), as harmonic_function reports it.
+  Eigen::VectorXd Lf = Eigen::VectorXd::Zero(m.nv), into_sink = Eigen::VectorXd::Zero(m.nv);
+  for (size_t e = 0; e < m.edges.size(); ++e) {
+    const auto [a, b] = m.edges[e];
+    const double w = m.weights[e], d = w * (result.f[a] - result.f[b]);
+    Lf[a] += d;
+    Lf[b] -= d;
+    if (b == result.sink) into_sink[a] += w;
+    if (a == result.sink) into_sink[b] += w;
+  }
+  double worst = 0, scale = 0;
+  for (int v = 0; v < m.nv; ++v) {
+    if (v == result.source || v == result.sink) continue;
+    worst = std::max(worst, std::abs(Lf[v]));
+    scale = std::max(scale, into_sink[v]);
+  }
+  result.residual = worst / std::max(scale, 1e-300);
+  result.intrinsic = m.intrinsic;
+  result.intrinsic_flips = m.intrinsic.flips;
+  result.negative_weights = m.negative_weights;
+  result.raised_weights = m.raised_weights;
   return result;
 }
 

@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include <memory>
+
 namespace polycube {
 
 struct HarmonicOptions {
@@ -56,5 +58,31 @@ struct HarmonicFunction {
 // Throws MeshError if the mesh is not of that kind or has no height (all z equal), and
 // AlgorithmError if the factorisation fails.
 HarmonicFunction harmonic_function(const TriMesh& mesh, const HarmonicOptions& options = {});
+
+// The part of harmonic_function that does not depend on which vertices are lowest and highest:
+// the intrinsic Delaunay triangulation and the cotangent Laplacian, factorised once, grounded at
+// one vertex. solve() then gives harmonic_function of any rigid motion or scaling of the mesh
+// (the orientation search's candidates) by one pair of triangular solves: u = L_g⁻¹(e_sink −
+// e_source) is harmonic at every vertex but those two (the grounded equation holds because the
+// others do and L's rows sum to zero), and f = (u − u_source) / (u_sink − u_source) is the
+// Dirichlet solution of eq. (1), the same as harmonic_function's up to rounding. The
+// triangulation's lengths are in the units of the mesh given here scaled to the unit cube.
+// Thread-safe: solves run one at a time.
+class HarmonicSolver {
+ public:
+  // Throws as harmonic_function does (but needs no height: that is the moved mesh's).
+  explicit HarmonicSolver(const TriMesh& mesh, const HarmonicOptions& options = {});
+  ~HarmonicSolver();
+  HarmonicSolver(const HarmonicSolver&) = delete;
+  HarmonicSolver& operator=(const HarmonicSolver&) = delete;
+
+  // f for `moved`: the mesh's faces, its vertices moved rigidly (and scaled). Throws
+  // std::invalid_argument for other faces or vertex counts, MeshError for no height.
+  HarmonicFunction solve(const TriMesh& moved) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace polycube

@@ -330,7 +330,7 @@ bool split_degenerate_saddle(TriMesh& mesh, int v, const std::vector<int>& z_cri
 
 }  // namespace
 
-TopologyResult analyse_topology(const TriMesh& mesh, const TopologyOptions& options) {
+TopologyResult analyse_topology(const TriMesh& mesh, const TopologyOptions& options, const HarmonicSolver* harmonic) {
   const auto start = Clock::now();
   TopologyResult result;
   result.euler = require_closed_surface(mesh);
@@ -338,7 +338,7 @@ TopologyResult analyse_topology(const TriMesh& mesh, const TopologyOptions& opti
 
   // §3.1: harmonic function and its critical points on the same (intrinsic) triangulation.
   auto t = Clock::now();
-  result.harmonic = harmonic_function(mesh, options.harmonic);
+  result.harmonic = harmonic ? harmonic->solve(mesh) : harmonic_function(mesh, options.harmonic);
   result.seconds_harmonic = seconds_since(t);
   t = Clock::now();
   CriticalPointOptions cp;

@@ -74,6 +74,8 @@ struct TopologyResult {
 // finite coordinates and a positive height; AlgorithmError when a piece of positive genus has all
 // its critical points of z at one height (no horizontal plane can separate them), when more than
 // max_planes planes would be needed, or when the pieces fail their own consistency checks.
-TopologyResult analyse_topology(const TriMesh& mesh, const TopologyOptions& options = {});
+// harmonic (optional): a solver built on this mesh's faces with options.harmonic, for step 1 (the
+// orientation search builds one for all its candidates, turned copies of one mesh).
+TopologyResult analyse_topology(const TriMesh& mesh, const TopologyOptions& options = {}, const HarmonicSolver* harmonic = nullptr);
 
 }  // namespace polycube

@@ -10,8 +10,11 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -109,6 +112,38 @@ TEST(HarmonicFunction, UnchangedUnderScalingAndTranslation) {
       EXPECT_LT((h.f - reference.f).cwiseAbs().maxCoeff(), 1e-9) << "scale " << scale << " shift " << shift;
     }
   }
+}
+
+TEST(HarmonicSolver, SameAsHarmonicFunctionOnTurnedCopies) {
+  // One factorisation for every orientation: each turned copy's f, from the grounded dipole,
+  // is harmonic_function's on that copy (same extremes, same values to rounding) and satisfies
+  // the same boundary values, residual and maximum principle.
+  const Eigen::Matrix3d turns[3] = {Eigen::Matrix3d::Identity(),
+                                    (Eigen::Matrix3d() << 0, 1, 0, 0, 0, 1, 1, 0, 0).finished(),
+                                    Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix()};
+  for (const auto& name : kMeshes) {
+    SCOPED_TRACE(name);
+    const TriMesh mesh = test::load_test_mesh(name);
+    const HarmonicSolver solver(mesh);
+    for (const Eigen::Matrix3d& turn : turns) {
+      TriMesh turned = mesh;
+      turned.V = mesh.V * turn.transpose();
+      const HarmonicFunction shared = solver.solve(turned);
+      expect_harmonic(turned, shared);
+      const HarmonicFunction own = harmonic_function(turned);
+      EXPECT_EQ(shared.source, own.source);
+      EXPECT_EQ(shared.sink, own.sink);
+      EXPECT_EQ(shared.negative_weights, own.negative_weights);
+      EXPECT_LT((shared.f - own.f).cwiseAbs().maxCoeff(), 1e-9);
+    }
+  }
+  const TriMesh sphere = test::make_sphere(2);
+  const HarmonicSolver solver(sphere);
+  TriMesh other = test::make_sphere(3);
+  EXPECT_THROW(solver.solve(other), std::invalid_argument);
+  TriMesh flat = sphere;
+  flat.V.col(2).setZero();
+  EXPECT_THROW(solver.solve(flat), MeshError);
 }
 
 TEST(HarmonicFunction, RejectsMeshesItCannotSolveOn) {
