@@ -32,76 +32,103 @@ void extreme_vertices(const Eigen::MatrixX3d& V, int& lowest, int& highest) {
   }
 }
 
-}  // namespace
-
-HarmonicFunction harmonic_function(const TriMesh& mesh, const HarmonicOptions& options) {
+// Throws MeshError unless the mesh has faces, every vertex used and one component.
+void require_solvable(const TriMesh& mesh) {
   const int nv = mesh.num_vertices();
-  if (nv == 0 || mesh.num_faces() == 0) throw MeshError("harmonic_function: empty mesh");
+  if (nv < 3 || mesh.num_faces() == 0) throw MeshError("harmonic_function: empty mesh");
   if (const int unused = count_unreferenced_vertices(mesh.F, nv); unused > 0)
     throw MeshError("harmonic_function: " + std::to_string(unused) + " vertices are used by no face");
   if (const int components = connected_components(mesh.F, nv); components != 1)
     throw MeshError("harmonic_function: mesh must be connected, got " + std::to_string(components) + " components");
+}
 
-  HarmonicFunction result;
-  extreme_vertices(mesh.V, result.source, result.sink);
-  if (!(mesh.V(result.sink, 2) > mesh.V(result.source, 2)))
-    throw MeshError("harmonic_function: mesh has no height (all z equal)");
-
-  // Unit-cube normalisation: only lengths matter, so scaling is enough.
+// The triangulation the Laplacian is built on, lengths of the mesh scaled to the unit cube (only
+// lengths matter, so scaling is enough): intrinsic Delaunay, or the mesh's own.
+IntrinsicTriangulation unit_intrinsic_triangulation(const TriMesh& mesh, const HarmonicOptions& options) {
   const double extent = bounding_box(mesh.V).extent().maxCoeff();
+  if (!(extent > 0)) throw MeshError("harmonic_function: mesh has no extent");
   const TriMesh unit{mesh.V / extent, mesh.F};
   IntrinsicDelaunayOptions idt;
   if (!options.intrinsic_delaunay) idt.max_flips_per_edge = 0;
-  result.intrinsic = intrinsic_delaunay(unit, idt);
-  result.intrinsic_flips = result.intrinsic.flips;
-  const IntrinsicTriangulation& T = result.intrinsic;
+  return intrinsic_delaunay(unit, idt);
+}
 
-  // Edge weights: each face adds half the cotangent of its angle opposite the edge.
-  // Free vertices are numbered 0..nv-3; source and sink are fixed.
-  std::vector<int> unknown(nv, -1);
-  int n = 0;
-  for (int v = 0; v < nv; ++v)
-    if (v != result.source && v != result.sink) unknown[v] = n++;
+// The cotangent weights, each edge once: each face adds half the cotangent of its angle opposite
+// the edge. negative: below -1e-10 times the mean (beyond rounding of cocircular quads). With
+// intrinsic Delaunay, weights below min_weight times the mean are raised to it (raised): zero
+// weights (cocircular quads) and the rare negative ones of edges the flips could not make
+// Delaunay (next to spike vertices); with all weights > 0 every free vertex lies strictly
+// between its lowest and highest neighbour (strict maximum principle).
+struct EdgeWeights {
+  std::vector<std::pair<int, int>> edges;
+  std::vector<double> weight;
+  int negative = 0;
+  int raised = 0;
+};
 
+EdgeWeights laplacian_weights(const IntrinsicTriangulation& T, const HarmonicOptions& options) {
   Eigen::MatrixX3d half_weight(T.F.rows(), 3);
   for (int f = 0; f < T.F.rows(); ++f)
     for (int i = 0; i < 3; ++i)
       half_weight(f, i) = half_cotan_opposite(T.length(f, i), T.length(f, (i + 1) % 3), T.length(f, (i + 2) % 3));
-  // Weight floor: a fraction of the mean edge weight.
   const double mean_weight = half_weight.sum() / (1.5 * T.F.rows());
   const double weight_floor = options.intrinsic_delaunay ? options.min_weight * mean_weight
                                                          : -std::numeric_limits<double>::infinity();
-
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(4 * 3 * T.F.rows() / 2 + nv);
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n), rhs = Eigen::VectorXd::Zero(n);
+  EdgeWeights out;
   for (int f = 0; f < T.F.rows(); ++f)
     for (int i = 0; i < 3; ++i) {
       const int g = T.adjacent(f, i), j = T.adjacent_edge(f, i);
       if (g < f || (g == f && j < i)) continue;  // each edge once
       double w = half_weight(f, i) + half_weight(g, j);
-      if (w < -1e-10 * mean_weight) ++result.negative_weights;  // beyond rounding of cocircular quads
+      if (w < -1e-10 * mean_weight) ++out.negative;
       if (w < weight_floor) {
-        // Zero weights (cocircular quads) and the rare negative weights of edges the flips could
-        // not make Delaunay (next to spike vertices) are raised to a small positive value: with
-        // all weights > 0 every free vertex lies strictly between its lowest and highest
-        // neighbour (strict maximum principle), instead of possibly equal to one of them.
         w = weight_floor;
-        ++result.raised_weights;
+        ++out.raised;
       }
-      const int a = T.F(f, i), b = T.F(f, (i + 1) % 3);
-      const int ua = unknown[a], ub = unknown[b];
-      // Row of a: w (f_a - f_b) = 0, moving fixed values to the right-hand side.
-      if (ua >= 0) diagonal[ua] += w;
-      if (ub >= 0) diagonal[ub] += w;
-      if (ua >= 0 && ub >= 0) {
-        triplets.emplace_back(std::max(ua, ub), std::min(ua, ub), -w);
-      } else if (ua >= 0 && b == result.sink) {
-        rhs[ua] += w;
-      } else if (ub >= 0 && a == result.sink) {
-        rhs[ub] += w;
-      }
+      out.edges.emplace_back(T.F(f, i), T.F(f, (i + 1) % 3));
+      out.weight.push_back(w);
     }
+  return out;
+}
+
+}  // namespace
+
+HarmonicFunction harmonic_function(const TriMesh& mesh, const HarmonicOptions& options) {
+  require_solvable(mesh);
+  const int nv = mesh.num_vertices();
+  HarmonicFunction result;
+  extreme_vertices(mesh.V, result.source, result.sink);
+  if (!(mesh.V(result.sink, 2) > mesh.V(result.source, 2)))
+    throw MeshError("harmonic_function: mesh has no height (all z equal)");
+  result.intrinsic = unit_intrinsic_triangulation(mesh, options);
+  result.intrinsic_flips = result.intrinsic.flips;
+  const EdgeWeights weights = laplacian_weights(result.intrinsic, options);
+  result.negative_weights = weights.negative;
+  result.raised_weights = weights.raised;
+
+  // Free vertices are numbered 0..nv-3; source and sink are fixed.
+  std::vector<int> unknown(nv, -1);
+  int n = 0;
+  for (int v = 0; v < nv; ++v)
+    if (v != result.source && v != result.sink) unknown[v] = n++;
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(weights.edges.size() + nv);
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n), rhs = Eigen::VectorXd::Zero(n);
+  for (size_t e = 0; e < weights.edges.size(); ++e) {
+    const auto [a, b] = weights.edges[e];
+    const double w = weights.weight[e];
+    const int ua = unknown[a], ub = unknown[b];
+    // Row of a: w (f_a - f_b) = 0, moving fixed values to the right-hand side.
+    if (ua >= 0) diagonal[ua] += w;
+    if (ub >= 0) diagonal[ub] += w;
+    if (ua >= 0 && ub >= 0) {
+      triplets.emplace_back(std::max(ua, ub), std::min(ua, ub), -w);
+    } else if (ua >= 0 && b == result.sink) {
+      rhs[ua] += w;
+    } else if (ub >= 0 && a == result.sink) {
+      rhs[ub] += w;
+    }
+  }
   for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, diagonal[i]);
   Eigen::SparseMatrix<double> L(n, n);
   L.setFromTriplets(triplets.begin(), triplets.end());  // lower triangle only
@@ -148,43 +175,18 @@ struct HarmonicSolver::Impl {
 };
 
 HarmonicSolver::HarmonicSolver(const TriMesh& mesh, const HarmonicOptions& options) : impl_(std::make_unique<Impl>()) {
+  require_solvable(mesh);
   const int nv = mesh.num_vertices();
-  if (nv < 3 || mesh.num_faces() == 0) throw MeshError("harmonic_function: empty mesh");
-  if (const int unused = count_unreferenced_vertices(mesh.F, nv); unused > 0)
-    throw MeshError("harmonic_function: " + std::to_string(unused) + " vertices are used by no face");
-  if (const int components = connected_components(mesh.F, nv); components != 1)
-    throw MeshError("harmonic_function: mesh must be connected, got " + std::to_string(components) + " components");
   Impl& m = *impl_;
   m.F = mesh.F;
   m.nv = nv;
   m.refinement_steps = options.refinement_steps;
-  const double extent = bounding_box(mesh.V).extent().maxCoeff();
-  if (!(extent > 0)) throw MeshError("harmonic_function: mesh has no extent");
-  const TriMesh unit{mesh.V / extent, mesh.F};
-  IntrinsicDelaunayOptions idt;
-  if (!options.intrinsic_delaunay) idt.max_flips_per_edge = 0;
-  m.intrinsic = intrinsic_delaunay(unit, idt);
-  const IntrinsicTriangulation& T = m.intrinsic;
-  Eigen::MatrixX3d half_weight(T.F.rows(), 3);
-  for (int f = 0; f < T.F.rows(); ++f)
-    for (int i = 0; i < 3; ++i)
-      half_weight(f, i) = half_cotan_opposite(T.length(f, i), T.length(f, (i + 1) % 3), T.length(f, (i + 2) % 3));
-  const double mean_weight = half_weight.sum() / (1.5 * T.F.rows());
-  const double weight_floor = options.intrinsic_delaunay ? options.min_weight * mean_weight
-                                                         : -std::numeric_limits<double>::infinity();
-  for (int f = 0; f < T.F.rows(); ++f)
-    for (int i = 0; i < 3; ++i) {
-      const int g = T.adjacent(f, i), j = T.adjacent_edge(f, i);
-      if (g < f || (g == f && j < i)) continue;  // each edge once
-      double w = half_weight(f, i) + half_weight(g, j);
-      if (w < -1e-10 * mean_weight) ++m.negative_weights;
-      if (w < weight_floor) {
-        w = weight_floor;
-        ++m.raised_weights;
-      }
-      m.edges.emplace_back(T.F(f, i), T.F(f, (i + 1) % 3));
-      m.weights.push_back(w);
-    }
+  m.intrinsic = unit_intrinsic_triangulation(mesh, options);
+  EdgeWeights weights = laplacian_weights(m.intrinsic, options);
+  m.negative_weights = weights.negative;
+  m.raised_weights = weights.raised;
+  m.edges = std::move(weights.edges);
+  m.weights = std::move(weights.weight);
   const int n = nv - 1;
   auto unknown = [&m](int v) { return v < m.ground ? v : v == m.ground ? -1 : v - 1; };
   std::vector<Eigen::Triplet<double>> triplets;
