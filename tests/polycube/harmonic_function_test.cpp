@@ -137,8 +137,18 @@ TEST(HarmonicSolver, SameAsHarmonicFunctionOnTurnedCopies) {
       EXPECT_LT((shared.f - own.f).cwiseAbs().maxCoeff(), 1e-9);
     }
   }
+  // The grounded vertex (0) as the source, then as the sink.
   const TriMesh sphere = test::make_sphere(2);
   const HarmonicSolver solver(sphere);
+  for (const double end : {-1.0, 1.0}) {
+    TriMesh turned = sphere;
+    const Eigen::Vector3d to = Eigen::Vector3d(0, 0, end);
+    turned.V = sphere.V * Eigen::Quaterniond::FromTwoVectors(sphere.V.row(0).transpose().normalized(), to).toRotationMatrix().transpose();
+    const HarmonicFunction shared = solver.solve(turned);
+    EXPECT_EQ(end < 0 ? shared.source : shared.sink, 0);
+    expect_harmonic(turned, shared);
+    EXPECT_LT((shared.f - harmonic_function(turned).f).cwiseAbs().maxCoeff(), 1e-9);
+  }
   TriMesh other = test::make_sphere(3);
   EXPECT_THROW(solver.solve(other), std::invalid_argument);
   TriMesh flat = sphere;
