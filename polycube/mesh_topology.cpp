@@ -20,9 +20,23 @@ EdgeMap build_edge_map(const Eigen::MatrixX3i& F) {
       const int u = F(f, i), v = F(f, (i + 1) % 3);
       halfedges.push_back({std::min(u, v), std::max(u, v), f, i});
     }
-  std::sort(halfedges.begin(), halfedges.end(), [](const HalfEdge& x, const HalfEdge& y) {
-    return x.a != y.a ? x.a < y.a : x.b != y.b ? x.b < y.b : x.face < y.face;
-  });
+  const auto by_b_then_face = [](const HalfEdge& x, const HalfEdge& y) { return x.b != y.b ? x.b < y.b : x.face < y.face; };
+  if (nf > 0 && F.minCoeff() >= 0) {
+    // Bucketed by the smaller vertex (counting sort), each bucket (a vertex's few edges) sorted
+    // by the larger vertex and the face: the order of one sort by (a, b, face), much faster.
+    const int nv = F.maxCoeff() + 1;
+    std::vector<int> start(nv + 1, 0);
+    for (const HalfEdge& h : halfedges) ++start[h.a + 1];
+    for (int v = 0; v < nv; ++v) start[v + 1] += start[v];
+    std::vector<HalfEdge> bucketed(halfedges.size());
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (const HalfEdge& h : halfedges) bucketed[next[h.a]++] = h;
+    for (int v = 0; v < nv; ++v) std::sort(bucketed.begin() + start[v], bucketed.begin() + start[v + 1], by_b_then_face);
+    halfedges = std::move(bucketed);
+  } else {
+    std::sort(halfedges.begin(), halfedges.end(),
+              [&](const HalfEdge& x, const HalfEdge& y) { return x.a != y.a ? x.a < y.a : by_b_then_face(x, y); });
+  }
 
   EdgeMap map;
   map.FE.resize(nf, 3);
