@@ -131,25 +131,33 @@ int connected_components(const Eigen::MatrixX3i& F, int num_vertices, Eigen::Vec
 
 int count_nonmanifold_vertices(const Eigen::MatrixX3i& F, int num_vertices) {
   // Around each vertex, faces sharing an edge through the vertex are linked; a manifold vertex
-  // has exactly one linked group of faces.
-  std::vector<std::vector<int>> vertex_faces(num_vertices);
+  // has exactly one linked group of faces. Faces round each vertex in CSR form.
+  std::vector<int> start(num_vertices + 1, 0);
   for (int f = 0; f < F.rows(); ++f)
-    for (int i = 0; i < 3; ++i) vertex_faces[F(f, i)].push_back(f);
+    for (int i = 0; i < 3; ++i) ++start[F(f, i) + 1];
+  for (int v = 0; v < num_vertices; ++v) start[v + 1] += start[v];
+  std::vector<int> faces_at(start.back());
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (int f = 0; f < F.rows(); ++f)
+    for (int i = 0; i < 3; ++i) faces_at[next[F(f, i)]++] = f;
 
   int bad = 0;
+  std::vector<std::pair<int, int>> by_neighbour;  // (other end of an edge through v, local face)
   for (int v = 0; v < num_vertices; ++v) {
-    const auto& faces = vertex_faces[v];
-    if (faces.size() <= 1) continue;
-    // Map each opposite-edge endpoint to the local faces containing it.
-    std::unordered_map<int, std::vector<int>> by_neighbour;
-    for (int k = 0; k < static_cast<int>(faces.size()); ++k)
+    const int count = start[v + 1] - start[v];
+    if (count <= 1) continue;
+    by_neighbour.clear();
+    for (int k = 0; k < count; ++k) {
+      const int f = faces_at[start[v] + k];
       for (int i = 0; i < 3; ++i)
-        if (F(faces[k], i) != v) by_neighbour[F(faces[k], i)].push_back(k);
-    DisjointSets local(static_cast<int>(faces.size()));
-    for (const auto& [neighbour, ks] : by_neighbour)
-      for (size_t j = 1; j < ks.size(); ++j) local.unite(ks[0], ks[j]);
+        if (F(f, i) != v) by_neighbour.emplace_back(F(f, i), k);
+    }
+    std::sort(by_neighbour.begin(), by_neighbour.end());
+    DisjointSets local(count);
+    for (size_t j = 1; j < by_neighbour.size(); ++j)
+      if (by_neighbour[j].first == by_neighbour[j - 1].first) local.unite(by_neighbour[j - 1].second, by_neighbour[j].second);
     int groups = 0;
-    for (int k = 0; k < static_cast<int>(faces.size()); ++k) groups += local.find(k) == k;
+    for (int k = 0; k < count; ++k) groups += local.find(k) == k;
     if (groups > 1) ++bad;
   }
   return bad;
