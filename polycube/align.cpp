@@ -213,7 +213,6 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   try {
     harmonic = std::make_unique<HarmonicSolver>(scored, topology.harmonic);
   } catch (const Error&) {
-    harmonic.reset();
   }
   std::vector<std::shared_ptr<TopologyResult>> topologies;
   std::vector<std::shared_ptr<PolycubeResult>> polycubes;

@@ -142,18 +142,18 @@ TriMesh triangulate_quads(const QuadMesh& mesh) {
   tri.V = mesh.V;
   tri.F.resize(2 * mesh.num_quads(), 3);
   for (int q = 0; q < mesh.num_quads(); ++q) {
-    const std::array<int, 4> c = {mesh.Q(q, 0), mesh.Q(q, 1), mesh.Q(q, 2), mesh.Q(q, 3)};
-    const double d02 = (mesh.V.row(c[0]) - mesh.V.row(c[2])).squaredNorm();
-    const double d13 = (mesh.V.row(c[1]) - mesh.V.row(c[3])).squaredNorm();
-    if (d02 <= d13) {
-      tri.F.row(2 * q) << c[0], c[1], c[2];
-      tri.F.row(2 * q + 1) << c[0], c[2], c[3];
-    } else {
-      tri.F.row(2 * q) << c[1], c[2], c[3];
-      tri.F.row(2 * q + 1) << c[1], c[3], c[0];
-    }
+    const auto corners = quad_triangle_corners(mesh, q);
+    for (int h = 0; h < 2; ++h)
+      for (int i = 0; i < 3; ++i) tri.F(2 * q + h, i) = mesh.Q(q, corners[h][i]);
   }
   return tri;
+}
+
+std::array<std::array<int, 3>, 2> quad_triangle_corners(const QuadMesh& mesh, int q) {
+  const double d02 = (mesh.V.row(mesh.Q(q, 0)) - mesh.V.row(mesh.Q(q, 2))).squaredNorm();
+  const double d13 = (mesh.V.row(mesh.Q(q, 1)) - mesh.V.row(mesh.Q(q, 3))).squaredNorm();
+  if (d02 <= d13) return {{{0, 1, 2}, {0, 2, 3}}};
+  return {{{1, 2, 3}, {1, 3, 0}}};
 }
 
 std::vector<std::vector<int>> quad_polygons(const QuadMesh& mesh) {

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <vector>
 
 namespace polycube {
@@ -66,6 +67,10 @@ std::vector<std::vector<int>> vertex_quads(const Eigen::MatrixX4i& Q, int num_ve
 // Two triangles per quad, split along the shorter diagonal (the split that keeps a folded quad
 // closest to its surface), for distance measurements and triangle-only tools.
 TriMesh triangulate_quads(const QuadMesh& mesh);
+
+// The corners (0..3) of quad q's two triangles as triangulate_quads splits it (positions from
+// mesh.V): along the diagonal 0-2 when it is not longer than 1-3, else along 1-3.
+std::array<std::array<int, 3>, 2> quad_triangle_corners(const QuadMesh& mesh, int q);
 
 // The quads as polygon lists, for write_polygon_mesh.
 std::vector<std::vector<int>> quad_polygons(const QuadMesh& mesh);

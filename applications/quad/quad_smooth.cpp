@@ -388,7 +388,6 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
     std::vector<int> lost;
     for (int q = 0; q < mesh.num_quads(); ++q)
       if (start_quad_state[q] & ~checked_state[q]) lost.push_back(q);
-    std::vector<char> touched(mesh.num_quads(), 0);
     while (!lost.empty()) {
       std::vector<int> again;
       for (int q : lost)
@@ -470,13 +469,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   auto quad_distance = [&](int q, const Eigen::Vector3d& x) {
     Eigen::Vector3d p[4];
     for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
-    const bool first = (p[0] - p[2]).squaredNorm() <= (p[1] - p[3]).squaredNorm();
-    const int t[2][3] = {{0, 1, 2}, {0, 2, 3}}, u[2][3] = {{1, 2, 3}, {1, 3, 0}};
     double best = INFINITY;
-    for (int h = 0; h < 2; ++h) {
-      const int* c = first ? t[h] : u[h];
+    for (const auto& c : quad_triangle_corners(mesh, q))
       best = std::min(best, (closest_on_triangle(x, p[c[0]], p[c[1]], p[c[2]]).point - x).norm());
-    }
     return best;
   };
   auto farthest = [&]() { return distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end()); };
@@ -487,10 +482,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     for (int q : around[v]) {
       Eigen::Vector3d p[4];
       for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
-      const bool first = (p[0] - p[2]).squaredNorm() <= (p[1] - p[3]).squaredNorm();
+      const auto t = quad_triangle_corners(mesh, q);
       const Eigen::Vector3d samples[6] = {(p[0] + p[1]) / 2, (p[1] + p[2]) / 2, (p[2] + p[3]) / 2, (p[3] + p[0]) / 2,
-                                          first ? (p[0] + p[1] + p[2]) / 3 : (p[1] + p[2] + p[3]) / 3,
-                                          first ? (p[0] + p[2] + p[3]) / 3 : (p[1] + p[3] + p[0]) / 3};
+                                          (p[t[0][0]] + p[t[0][1]] + p[t[0][2]]) / 3, (p[t[1][0]] + p[t[1][1]] + p[t[1][2]]) / 3};
       for (const Eigen::Vector3d& y : samples) off = std::max(off, surface.closest(y, quad_hit[q]).distance);
     }
     return off;
