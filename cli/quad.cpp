@@ -35,6 +35,9 @@ struct QuadCommandOptions {
   double cell_size = 0;
   std::string map_dir;
   int smooth = 40;
+  int refine = 3;
+  double refine_target = 0.25;
+  double refine_growth = 1.3;
   bool fit = true;
   std::string report_path;
   std::string preview_path;
@@ -231,6 +234,10 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   remesh.grid.cell_size = options.cell_size;
   remesh.grid.target_quads = options.target_faces;
   remesh.smooth.sweeps = options.smooth;
+  remesh.refine.rounds = options.refine;
+  remesh.refine.target_percent = options.refine_target;
+  remesh.refine.max_growth = options.refine_growth;
+  remesh.refine.threads = remesh.carry.threads;
   if (!options.fit) remesh.fit.passes = 0;
   const QuadRemeshResult result =
       remesh_quads(*polycube_mesh, to_model, *projector, remesh,
@@ -261,6 +268,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   write_polygon_mesh(options.output, result.mesh.V, quad_polygons(result.mesh));
   seconds["grid"] = result.seconds_grid;
   seconds["carry"] = result.seconds_carry;
+  seconds["refine"] = result.seconds_refine;
   seconds["smooth"] = result.seconds_smooth;
   seconds["fit"] = result.seconds_fit;
   seconds["quality"] = result.seconds_quality;
@@ -291,7 +299,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                       {"level_cells", grid.level_cells},
                       {"free_loops_removed", grid.free_loops},
                       {"layout_cells", grid.layout.num_quads()},
-                      {"chords", grid.chords}};
+                      {"chords", grid.chords},
+                      {"refine_rounds", result.refine_rounds},
+                      {"refined_chord_parts", grid.refined_parts},
+                      {"miss_before_refinement", result.refine_miss_before},
+                      {"miss_after_refinement", result.refine_miss_after}};
     report["smoothing"] = {{"sweeps", result.smoothing.sweeps},       {"moves", result.smoothing.moves},
                            {"refused", result.smoothing.rejected},    {"reverted", result.smoothing.reverted},
                            {"converged", result.smoothing.converged}, {"largest_move", result.smoothing.largest_move}};
@@ -334,6 +346,19 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
   command->add_option("--smooth", options->smooth, "Relaxation sweeps on the model at most, towards right angles and even sizes (stops when converged; never flips a quad; 0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0, 10000));
+  command->add_option("--refine", options->refine,
+                      "Rounds of local refinement where the finished quads miss the model (grid lines added along whole chords: "
+                      "still all-quad, irregular only at corners; each round relaxes and fits again; 0: the uniform grid)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100));
+  command->add_option("--refine-target", options->refine_target,
+                      "Refine until the quads miss the model by at most this % of the bounding-box diagonal")
+      ->capture_default_str()
+      ->check(CLI::Range(1e-3, 100.0));
+  command->add_option("--refine-growth", options->refine_growth,
+                      "The refinement adds at most this factor of quads (1.3: up to 30 % more than the uniform grid)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 100.0));
   command->add_flag("--no-fit{false}", options->fit,
                    "Do not pull quad corners onto the model's tips and edges the quads miss (the fit, after the relaxation)");
   command->add_option("--report", options->report_path, "Write the quality report as JSON to this file");

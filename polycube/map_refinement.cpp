@@ -38,19 +38,6 @@ constexpr double kDegenerateArea = 1e-14;
 
 Vec3 row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpose(); }
 
-// Runs work(i) for i in [0, n) on `threads` threads, in interleaved blocks.
-template <class Work>
-void parallel_range(int n, int threads, Work&& work) {
-  if (n <= 0) return;
-  constexpr int kBlocks = 64;
-  std::vector<int> blocks(std::min(kBlocks, n));
-  std::iota(blocks.begin(), blocks.end(), 0);
-  const int stride = static_cast<int>(blocks.size());
-  parallel_for_each(blocks, threads, "block", [&](int block) {
-    for (int i = block; i < n; i += stride) work(i);
-  });
-}
-
 // The audit's judgement of image triangles on the model (map_audit.cpp, audit_map_direction):
 // closest faces from the same AABB tree over the same triangles (zero-area faces left out), so
 // every tie is broken the same way.

@@ -74,17 +74,6 @@ Lists vertex_faces(const TriMesh& mesh) {
   return Lists(mesh.num_vertices(), pairs);
 }
 
-// Runs work(i) for i in [0, n) on `threads` threads, in interleaved blocks.
-template <class Work>
-void parallel_range(int n, int threads, Work&& work) {
-  constexpr int kBlocks = 64;
-  std::vector<int> blocks(kBlocks);
-  std::iota(blocks.begin(), blocks.end(), 0);
-  parallel_for_each(blocks, threads, "block", [&](int block) {
-    for (int i = block; i < n; i += kBlocks) work(i);
-  });
-}
-
 // ---------------------------------------------------------------------------------------------
 // A closed triangle mesh with what the smoothing asks of it: adjacency across edges, intrinsic
 // angle sums, normals, and local closest points.

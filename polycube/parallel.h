@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <numeric>
 #include <string>
 #include <thread>
 #include <vector>
@@ -51,6 +52,20 @@ int parallel_for_each(const std::vector<int>& order, int threads, const std::str
     }
   }
   return threads;
+}
+
+// Runs work(i) for i in [0, n) on `threads` threads (0: one per hardware thread), in 64
+// interleaved blocks; errors as parallel_for_each's (prefixed "block <k>: ").
+template <class Work>
+void parallel_range(int n, int threads, Work&& work) {
+  if (n <= 0) return;
+  constexpr int kBlocks = 64;
+  std::vector<int> blocks(std::min(kBlocks, n));
+  std::iota(blocks.begin(), blocks.end(), 0);
+  const int stride = static_cast<int>(blocks.size());
+  parallel_for_each(blocks, threads, "block", [&](int block) {
+    for (int i = block; i < n; i += stride) work(i);
+  });
 }
 
 }  // namespace polycube

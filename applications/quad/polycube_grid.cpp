@@ -15,6 +15,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <queue>
 #include <sstream>
 #include <stdexcept>
@@ -597,6 +598,99 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
       }
     }
   }
+  // Refinement: per chord the cut fractions of its width (ascending along the width's axis, the
+  // same in every cell of the chord: a chord keeps its axis and its interval of it across P's
+  // edges), equal parts, then halved where asked.
+  std::vector<std::vector<double>> cuts(num_chords);
+  for (int k = 0; k < num_chords; ++k) {
+    cuts[k].resize(part[k] + 1);
+    for (long long i = 0; i <= part[k]; ++i) cuts[k][i] = static_cast<double>(i) / static_cast<double>(part[k]);
+  }
+  // The slot of cell s whose sides run along axis (a + 1) % 3 (side 0 for an outward +e_a cell).
+  const auto slot_along_b = [&](int s) { return 2 * s + (cells[s].sign > 0 ? 0 : 1); };
+  if (!options.refine_rounds.empty()) {
+    // A chord whose width is not one interval of one axis in all its cells (not expected: the
+    // sides it crosses are parallel to P's edges it crosses) keeps equal parts, which read the
+    // same either way.
+    std::vector<char> refinable(num_chords, 1);
+    {
+      std::vector<std::array<double, 3>> extent(num_chords, {-1, 0, 0});  // axis, lo, hi
+      for (int s = 0; s < num_cells; ++s) {
+        const Rectangle& r = cells[s];
+        const int b = (r.axis + 1) % 3, c = (r.axis + 2) % 3;
+        const std::array<double, 3> along_b = {double(b), grid.levels[b][r.i0], grid.levels[b][r.i1]};
+        const std::array<double, 3> along_c = {double(c), grid.levels[c][r.j0], grid.levels[c][r.j1]};
+        for (const auto& [slot, e] : {std::make_pair(slot_along_b(s), along_b), std::make_pair(slot_along_b(s) ^ 1, along_c)}) {
+          std::array<double, 3>& known = extent[chord_of[slot]];
+          if (known[0] < 0) known = e;
+          else if (known != e) refinable[chord_of[slot]] = 0;
+        }
+      }
+    }
+    std::map<std::array<int, 3>, std::vector<int>> cells_on_plane;  // (axis, sign, level) -> cells
+    for (int s = 0; s < num_cells; ++s) cells_on_plane[{cells[s].axis, cells[s].sign, cells[s].level}].push_back(s);
+    const double budget = options.refine_max_quads > 0 ? static_cast<double>(options.refine_max_quads)
+                                                       : std::numeric_limits<double>::infinity();
+    bool full = false;
+    for (const std::vector<GridRefinement>& round : options.refine_rounds) {
+      std::map<std::pair<int, double>, int> inserted;  // (chord, cut) added this round -> by which point
+      for (size_t n = 0; n < round.size(); ++n) {
+        if (full) break;
+        const SurfacePoint& point = round[n].point;
+        if (point.face < 0 || point.face >= mesh.num_faces())
+          throw std::invalid_argument("refinement point on triangle " + std::to_string(point.face) + " of a polycube with " +
+                                      std::to_string(mesh.num_faces()));
+        if (round[n].halvings < 1 || round[n].halvings > 30)
+          throw std::invalid_argument("refinement halvings must be 1..30, got " + std::to_string(round[n].halvings));
+        Eigen::Vector3d x = Eigen::Vector3d::Zero();
+        for (int i = 0; i < 3; ++i) x += point.bary[i] * mesh.V.row(mesh.F(point.face, i)).transpose();
+        const TriangleLabel& label = labels[point.face];
+        const int a = label.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+        const auto plane = cells_on_plane.find({a, label.sign, label.level});
+        if (plane == cells_on_plane.end()) continue;
+        const auto by_other = [&](int k, double cut) {
+          const auto it = inserted.find({k, cut});
+          return it != inserted.end() && it->second != static_cast<int>(n);
+        };
+        for (int s : plane->second) {
+          const Rectangle& r = cells[s];
+          const double B0 = grid.levels[b][r.i0], B1 = grid.levels[b][r.i1], C0 = grid.levels[c][r.j0], C1 = grid.levels[c][r.j1];
+          if (x[b] < B0 - tolerance || x[b] > B1 + tolerance || x[c] < C0 - tolerance || x[c] > C1 + tolerance) continue;
+          const int slot_b = slot_along_b(s);
+          std::vector<std::pair<int, double>> added;
+          for (const auto& [slot, t] : {std::make_pair(slot_b, (x[b] - B0) / (B1 - B0)), std::make_pair(slot_b ^ 1, (x[c] - C0) / (C1 - C0))}) {
+            const int k = chord_of[slot];
+            if (!refinable[k]) continue;
+            std::vector<double>& cut = cuts[k];
+            for (int halving = 0; halving < round[n].halvings; ++halving) {
+              const int i = std::clamp(static_cast<int>(std::upper_bound(cut.begin(), cut.end(), t) - cut.begin()) - 1, 0,
+                                       static_cast<int>(cut.size()) - 2);
+              if (by_other(k, cut[i]) || by_other(k, cut[i + 1])) break;  // halved by another point this round
+              const double middle = (cut[i] + cut[i + 1]) / 2;
+              if (!(middle > cut[i] && middle < cut[i + 1])) break;  // as fine as doubles go
+              cut.insert(cut.begin() + i + 1, middle);
+              ++part[k];
+              added.emplace_back(k, middle);
+              inserted[{k, middle}] = static_cast<int>(n);
+            }
+          }
+          if (!added.empty() && count_parts() > budget) {  // over the budget: undo this point, stop
+            for (const auto& [k, middle] : added) {
+              cuts[k].erase(std::find(cuts[k].begin(), cuts[k].end(), middle));
+              --part[k];
+              inserted.erase({k, middle});
+            }
+            full = true;
+          } else {
+            grid.refined_parts += static_cast<int>(added.size());
+          }
+          break;
+        }
+      }
+    }
+    for (int k = 0; k < num_chords; ++k) part[k] = static_cast<long long>(cuts[k].size()) - 1;
+  }
+
   const double quads = count_parts();
   if (quads > static_cast<double>(options.max_quads))
     throw AlgorithmError("cell size " + std::to_string(h) + " gives " + std::to_string(static_cast<long long>(quads)) +
@@ -618,8 +712,8 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
     if (inserted) points.push_back(p);
     return it->second;
   };
-  const auto split = [](double lo, double hi, long long i, long long n) {
-    return i == n ? hi : lo + (hi - lo) * static_cast<double>(i) / static_cast<double>(n);
+  const auto split = [](double lo, double hi, const std::vector<double>& cut, long long i) {
+    return i + 1 == static_cast<long long>(cut.size()) ? hi : lo + (hi - lo) * cut[i];
   };
   std::vector<int> row;
   for (int s = 0; s < num_cells; ++s) {
@@ -636,8 +730,8 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
       for (long long j = 0; j <= nc; ++j) {
         Eigen::Vector3d p;
         p[a] = grid.levels[a][r.level];
-        p[b] = split(B0, B1, i, nb);
-        p[c] = split(C0, C1, j, nc);
+        p[b] = split(B0, B1, cuts[chord_of[slot_along_b(s)]], i);
+        p[c] = split(C0, C1, cuts[chord_of[slot_along_b(s) ^ 1]], j);
         row[i * (nc + 1) + j] = vertex(p);
       }
     for (long long i = 0; i < nb; ++i)

@@ -14,6 +14,10 @@
 //    equal parts, the same along its whole length, so each cell becomes a grid of near-square
 //    quads whose lines continue into its neighbours: still no T-junctions, and a vertex has 4
 //    quads except where P's total angle is not 2π — its corners.
+// 4. Refinement (optional): a chord's parts need not be equal. Halving one part adds a line along
+//    the whole chord at the same fraction of its width in every cell, so the layout stays
+//    conforming; the quad application uses it where the carried quads miss the model
+//    (refine_quads_to_model, quad_remesh.h).
 #pragma once
 
 #include "applications/quad/quad_mesh.h"
@@ -32,6 +36,12 @@ namespace polycube {
 // barycentric coordinates) to its image (φ: P → M).
 using SurfaceMap = std::function<Eigen::Vector3d(const SurfacePoint&)>;
 
+// A place where the grid should be finer (PolycubeGridOptions::refine_rounds).
+struct GridRefinement {
+  SurfacePoint point;
+  int halvings = 1;
+};
+
 struct PolycubeGridOptions {
   // Quad size h in input units (on M when the grid is sized through a map); 0: chosen from
   // target_quads.
@@ -47,6 +57,16 @@ struct PolycubeGridOptions {
   double merge_tolerance = 1e-9;
   // More quads than this is an error (a cell size far too small for the shape).
   long long max_quads = 20'000'000;
+  // Local refinement, in rounds (step 4 above): each point of a round is a point of P (a triangle
+  // of the given mesh and barycentric coordinates); the part containing it of each of the two
+  // chords through its cell is halved, `halvings` times (each time the half holding the point).
+  // A part next to a cut another point of the same round made is not halved again in that round.
+  // A halved part is a new grid line along the whole chord, so the grid stays conforming and no
+  // vertex becomes irregular; quads there become rectangles on P. Empty: the uniform split.
+  std::vector<std::vector<GridRefinement>> refine_rounds;
+  // More quads than this (0: no limit) stops the refinement before the point that would exceed
+  // it; the points are taken in order, so put the most important first.
+  long long refine_max_quads = 0;
 };
 
 // The grid on P.
@@ -72,6 +92,7 @@ struct PolycubeGridOptions {
 //   level_cells   cells between consecutive levels (before removing free loops)
 //   free_loops    loops removed
 //   chords        of the layout
+//   refined_parts chord parts halved by options.refine_rounds
 //   sized_through_map  chord widths were measured on the map's images
 //   seconds       wall time
 struct PolycubeGrid {
@@ -89,6 +110,7 @@ struct PolycubeGrid {
   long long level_cells = 0;
   int free_loops = 0;
   int chords = 0;
+  int refined_parts = 0;
   bool sized_through_map = false;
   double seconds = 0;
 };

@@ -7,12 +7,17 @@
 //   quads   = smooth_quads(quads, M)            optional: towards right angles, never flips a quad
 //   quads   = fit_quads(quads, M)               optional: corners pulled onto the model's tips,
 //                                               then relaxed again around them (pinned)
+//   repeat: find_quad_misses(grid, quads, M)    optional: where the finished quads miss M, taken
+//           grid = build_polycube_grid(+ those) back to P; the chord parts there halved; the
+//           carry, smooth, fit again            grid carried, relaxed and fitted again; kept when
+//                                               it misses less and flips nothing more
 //   quality = measure_quads(quads, M, corners)
 #pragma once
 
 #include "applications/quad/carry_grid.h"
 #include "applications/quad/polycube_grid.h"
 #include "applications/quad/quad_quality.h"
+#include "applications/quad/quad_refine.h"
 #include "applications/quad/quad_smooth.h"
 #include "applications/quad/surface_projector.h"
 
@@ -22,7 +27,7 @@
 namespace polycube {
 
 // Called when a step starts and when it ends: (stage, message). Stages: "grid", "carry",
-// "smooth", "fit", "quality".
+// "refine", "smooth", "fit", "quality".
 using QuadProgress = std::function<void(const std::string& stage, const std::string& message)>;
 
 struct QuadRemeshOptions {
@@ -31,6 +36,7 @@ struct QuadRemeshOptions {
   // are near h wide on the model where φ stretches or shrinks P.
   bool size_on_model = true;
   CarryOptions carry;
+  QuadRefineOptions refine;
   QuadSmoothOptions smooth;
   // The fit to the model's extremities after the relaxation (passes 0: none), then this many
   // relaxation sweeps with the pulled vertices pinned (at most smooth.sweeps).
@@ -43,6 +49,8 @@ struct QuadRemeshOptions {
 // Everything produced.
 //   grid       the grid on P (positions on P, vertices as points of P, corners)
 //   mesh       the quads on M (grid's connectivity)
+//   refine_rounds  refinement rounds kept; refine_miss_before / _after: the farthest miss
+//              (find_quad_misses) of the uniform and of the refined carried grid, input units
 //   smoothing  what the relaxation did (nothing when options.smooth.sweeps is 0)
 //   fitting    what the fit did (its mesh left empty; nothing when options.fit.passes is 0)
 //   refitting  the relaxation after the fit, pulled vertices pinned (its mesh left empty)
@@ -51,12 +59,16 @@ struct QuadRemeshOptions {
 struct QuadRemeshResult {
   PolycubeGrid grid;
   QuadMesh mesh;
+  int refine_rounds = 0;
+  double refine_miss_before = 0;
+  double refine_miss_after = 0;
   QuadSmoothResult smoothing;
   QuadFitResult fitting;
   QuadSmoothResult refitting;
   QuadQuality quality;
   double seconds_grid = 0;
   double seconds_carry = 0;
+  double seconds_refine = 0;
   double seconds_smooth = 0;
   double seconds_fit = 0;
   double seconds_quality = 0;

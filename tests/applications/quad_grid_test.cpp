@@ -134,7 +134,9 @@ Eigen::VectorXd angle_sums(const TriMesh& mesh) {
 std::tuple<double, double, double> key_of(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
 
 // Every property of the grid that holds on any polycube.
-void expect_valid_grid(const TriMesh& P, const PolycubeGrid& grid) {
+// equal_parts: every cell split into equal quads (false for a locally refined grid, whose chords
+// have unequal parts).
+void expect_valid_grid(const TriMesh& P, const PolycubeGrid& grid, bool equal_parts = true) {
   const QuadMesh& quads = grid.mesh;
   const int nv = quads.num_vertices(), nq = quads.num_quads();
   ASSERT_GT(nq, 0);
@@ -235,7 +237,7 @@ void expect_valid_grid(const TriMesh& P, const PolycubeGrid& grid) {
       if (std::abs(edge - side / grid.cell_parts(s, k % 2)) > 1e-12 * diagonal) ++wrong_size;
     }
   }
-  EXPECT_EQ(wrong_size, 0);
+  if (equal_parts) EXPECT_EQ(wrong_size, 0);
   for (int s = 0; s < grid.layout.num_quads(); ++s) EXPECT_EQ(per_cell[s], grid.cell_parts(s, 0) * grid.cell_parts(s, 1));
   for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::is_sorted(grid.levels[a].begin(), grid.levels[a].end()));
   for (int q = 0; q < nq; ++q) {
@@ -261,6 +263,94 @@ TEST(QuadGrid, SyntheticPolycubes) {
         EXPECT_EQ(grid.mesh.num_quads(), grid.layout.num_quads()) << "one quad per layout cell";
       }
     }
+  }
+}
+
+double triangle_area(const TriMesh& mesh, int f) {
+  const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+  return (b - a).cross(c - a).norm() / 2;
+}
+
+// The sides of the grid quads on P that contain point x (on the plane of triangle f's face).
+std::vector<double> sides_of_quads_at(const TriMesh& P, const PolycubeGrid& grid, int f, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d n = (P.V.row(P.F(f, 1)) - P.V.row(P.F(f, 0))).cross(P.V.row(P.F(f, 2)) - P.V.row(P.F(f, 0))).transpose();
+  std::vector<double> sides;
+  for (int q = 0; q < grid.mesh.num_quads(); ++q) {
+    const int axis = std::abs(grid.quad_axis[q]) - 1;
+    if (n.cwiseAbs().maxCoeff() != std::abs(n[axis]) || (n[axis] > 0) != (grid.quad_axis[q] > 0)) continue;
+    if (std::abs(grid.mesh.V(grid.mesh.Q(q, 0), axis) - x[axis]) > 1e-12) continue;
+    Eigen::Vector3d lo = grid.mesh.V.row(grid.mesh.Q(q, 0)), hi = lo;
+    for (int k = 1; k < 4; ++k) {
+      lo = lo.cwiseMin(grid.mesh.V.row(grid.mesh.Q(q, k)).transpose());
+      hi = hi.cwiseMax(grid.mesh.V.row(grid.mesh.Q(q, k)).transpose());
+    }
+    if (((x - lo).array() < -1e-12).any() || ((hi - x).array() < -1e-12).any()) continue;
+    for (int a = 0; a < 3; ++a)
+      if (a != axis) sides.push_back(hi[a] - lo[a]);
+  }
+  return sides;
+}
+
+// Local refinement: each round halves the parts of the two chords through a point, so the quads
+// there shrink by half per round while the grid stays a valid conforming grid (irregular only
+// at P's corners); several points in one part halve it once; the budget stops it.
+TEST(QuadGrid, RefinementHalvesThePartsAtAPoint) {
+  for (const Shape& shape : synthetic_shapes()) {
+    SCOPED_TRACE(shape.name);
+    const TriMesh& P = shape.mesh;
+    PolycubeGridOptions options;
+    options.target_quads = 300;
+    const PolycubeGrid base = build_polycube_grid(P, options);
+    // A point inside a face, on no dyadic line: in the largest triangle.
+    int f = 0;
+    for (int g = 0; g < P.num_faces(); ++g)
+      if (triangle_area(P, g) > triangle_area(P, f)) f = g;
+    SurfacePoint point;
+    point.face = f;
+    point.bary = Eigen::Vector3d(0.21, 0.33, 0.46);
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) x += point.bary[i] * P.V.row(P.F(f, i)).transpose();
+    const std::vector<double> before = sides_of_quads_at(P, base, f, x);
+    ASSERT_FALSE(before.empty());
+    const double largest_before = *std::max_element(before.begin(), before.end());
+
+    int previous_quads = base.mesh.num_quads();
+    for (int rounds = 1; rounds <= 3; ++rounds) {
+      SCOPED_TRACE("rounds " + std::to_string(rounds));
+      options.refine_rounds.push_back({GridRefinement{point, 1}});
+      const PolycubeGrid refined = build_polycube_grid(P, options);
+      expect_valid_grid(P, refined, false);
+      EXPECT_EQ(refined.refined_parts, 2 * rounds) << "one part of each of the two chords per round";
+      EXPECT_GT(refined.mesh.num_quads(), previous_quads);
+      previous_quads = refined.mesh.num_quads();
+      const std::vector<double> after = sides_of_quads_at(P, refined, f, x);
+      ASSERT_FALSE(after.empty());
+      EXPECT_LE(*std::max_element(after.begin(), after.end()), largest_before / (1 << rounds) * (1 + 1e-9));
+    }
+
+    // The same point twice in one round: halved once.
+    PolycubeGridOptions twice;
+    twice.target_quads = 300;
+    twice.refine_rounds = {{GridRefinement{point, 1}, GridRefinement{point, 1}}};
+    EXPECT_EQ(build_polycube_grid(P, twice).refined_parts, 2);
+    // No room in the budget: nothing refined.
+    twice.refine_max_quads = base.mesh.num_quads();
+    const PolycubeGrid capped = build_polycube_grid(P, twice);
+    EXPECT_EQ(capped.refined_parts, 0);
+    EXPECT_EQ(capped.mesh.num_quads(), base.mesh.num_quads());
+    // A point on no triangle of P is an error.
+    // Three halvings at once: as three rounds of one.
+    twice.refine_max_quads = 0;
+    twice.refine_rounds = {{GridRefinement{point, 3}}};
+    const PolycubeGrid deep = build_polycube_grid(P, twice);
+    expect_valid_grid(P, deep, false);
+    EXPECT_EQ(deep.refined_parts, 6);
+    EXPECT_EQ(deep.mesh.num_quads(), previous_quads);
+    // A point on no triangle of P, or no halving, is an error.
+    twice.refine_rounds = {{GridRefinement{SurfacePoint{P.num_faces(), Eigen::Vector3d(1, 0, 0)}, 1}}};
+    EXPECT_THROW(build_polycube_grid(P, twice), std::invalid_argument);
+    twice.refine_rounds = {{GridRefinement{point, 0}}};
+    EXPECT_THROW(build_polycube_grid(P, twice), std::invalid_argument);
   }
 }
 

@@ -44,6 +44,7 @@ QuadRemeshResult remesh(const Mapped& m, int quads, int sweeps) {
   QuadRemeshOptions options;
   options.grid.target_quads = quads;
   options.smooth.sweeps = sweeps;
+  options.refine.rounds = 0;  // the same grid either way: what the relaxation does is compared
   const SurfaceMap to_model = [&m](const SurfacePoint& p) { return surface_position(m.model, m.map.to_model(p)); };
   return remesh_quads(m.polycube.polycube.mesh, to_model, *m.projector, options);
 }

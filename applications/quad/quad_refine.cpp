@@ -1,0 +1,106 @@
+#include "applications/quad/quad_refine.h"
+
+#include "polycube/closest_point.h"
+#include "polycube/parallel.h"
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+#include <utility>
+
+namespace polycube {
+
+namespace {
+// The point on triangle f of `mesh` closest to x, as a surface point.
+SurfacePoint surface_point(const TriMesh& mesh, int f, const Eigen::Vector3d& x) {
+  const TriangleClosest closest = closest_on_triangle(x, mesh.V.row(mesh.F(f, 0)).transpose(), mesh.V.row(mesh.F(f, 1)).transpose(),
+                                                      mesh.V.row(mesh.F(f, 2)).transpose());
+  SurfacePoint point;
+  point.face = f;
+  point.bary = closest.bary;
+  return point;
+}
+}  // namespace
+
+PreimageLocator::PreimageLocator(const TriMesh& polycube, const SurfaceMap& to_model, int threads)
+    : polycube_(polycube), on_polycube_(std::make_unique<SurfaceProjector>(polycube)) {
+  const int nv = polycube.num_vertices();
+  std::vector<SurfacePoint> at_vertex(nv);
+  for (int f = 0; f < polycube.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      SurfacePoint& p = at_vertex[polycube.F(f, i)];
+      p.face = f;
+      p.bary = Eigen::Vector3d::Unit(i);
+    }
+  images_.F = polycube.F;
+  images_.V.resize(nv, 3);
+  parallel_range(nv, threads, [&](int v) {
+    if (at_vertex[v].face >= 0)
+      images_.V.row(v) = to_model(at_vertex[v]).transpose();
+    else
+      images_.V.row(v) = polycube.V.row(v);  // on no triangle: never a closest point's corner that matters
+  });
+  if (!images_.V.allFinite()) throw AlgorithmError("the map sends a vertex of P to a non-finite point");
+  on_images_ = std::make_unique<SurfaceProjector>(images_);
+}
+
+SurfacePoint PreimageLocator::preimage(const Eigen::Vector3d& x) const {
+  const int f = on_images_->closest(x).face;
+  SurfacePoint point = surface_point(images_, f, x);
+  return point;
+}
+
+SurfacePoint PreimageLocator::on_polycube(const Eigen::Vector3d& p) const {
+  return surface_point(polycube_, on_polycube_->closest(p).face, p);
+}
+
+QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model,
+                          const PreimageLocator& locator, double distance, double cell_size, int threads) {
+  const TriMesh& surface = model.surface();
+  const SurfaceProjector on_quads(triangulate_quads(quads));
+  // Points of M: its vertices, then centroid and edge midpoints of its large triangles.
+  std::vector<Eigen::Vector3d> samples;
+  samples.reserve(surface.num_vertices());
+  for (int v = 0; v < surface.num_vertices(); ++v) samples.push_back(surface.V.row(v).transpose());
+  for (int f = 0; f < surface.num_faces(); ++f) {
+    const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)), b = surface.V.row(surface.F(f, 1)), c = surface.V.row(surface.F(f, 2));
+    if (std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}) <= cell_size / 4) continue;
+    samples.push_back((a + b + c) / 3);
+    samples.push_back((a + b) / 2);
+    samples.push_back((b + c) / 2);
+    samples.push_back((c + a) / 2);
+  }
+  const int ns = static_cast<int>(samples.size()), nq = quads.num_quads();
+  // Per candidate: its distance and its point of P (set when a miss).
+  std::vector<double> miss(ns + nq, 0);
+  std::vector<SurfacePoint> where(ns + nq);
+  parallel_range(ns + nq, threads, [&](int k) {
+    if (k < ns) {
+      miss[k] = on_quads.closest(samples[k]).distance;
+      if (miss[k] > distance) where[k] = locator.preimage(samples[k]);
+    } else {
+      const int q = k - ns;
+      Eigen::Vector3d on_model = Eigen::Vector3d::Zero(), on_p = Eigen::Vector3d::Zero();
+      for (int i = 0; i < 4; ++i) {
+        on_model += quads.V.row(quads.Q(q, i)).transpose() / 4;
+        on_p += grid.mesh.V.row(grid.mesh.Q(q, i)).transpose() / 4;
+      }
+      miss[k] = model.closest(on_model).distance;
+      if (miss[k] > distance) where[k] = locator.on_polycube(on_p);
+    }
+  });
+  QuadMiss result;
+  std::vector<int> order;
+  for (int k = 0; k < ns + nq; ++k) {
+    result.farthest = std::max(result.farthest, miss[k]);
+    if (miss[k] > distance) order.push_back(k);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return miss[x] > miss[y]; });
+  for (int k : order) {
+    result.points.push_back(where[k]);
+    result.distances.push_back(miss[k]);
+  }
+  return result;
+}
+
+}  // namespace polycube

@@ -1,0 +1,76 @@
+// Local refinement of the quad grid where the quads miss the model (issue 7's Hausdorff bound).
+// A uniform grid on P carried by φ is coarse on M wherever φ squeezes a part of M into a small
+// part of P (a horn, an ear, a fin): the model sticks out between the quads. The places are
+// found on the finished quads (find_quad_misses) and taken back to P (PreimageLocator), where the grid's chords through them get
+// their parts halved (PolycubeGridOptions::refine_rounds): a new grid line along each chord, so
+// the grid stays conforming, all-quad and irregular only at P's corners.
+#pragma once
+
+#include "applications/quad/polycube_grid.h"
+#include "applications/quad/quad_mesh.h"
+#include "applications/quad/surface_projector.h"
+#include "polycube/mesh.h"
+#include "polycube/polycube_map.h"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace polycube {
+
+struct QuadRefineOptions {
+  // Rounds of refinement (each: find the misses of the finished quads, halve the chord parts
+  // there, carry, relax and fit again: a whole pass); 0: none.
+  int rounds = 3;
+  // Each round refines at the misses within this fraction of the farthest one (the worst
+  // places first; the others may be fixed on the way, or in a later round).
+  double worst_fraction = 0.6;
+  // Aim, in % of the model's bounding-box diagonal: every vertex of M within it from the
+  // carried quads, every quad's centre within it from M.
+  double target_percent = 0.25;
+  // At most this times the unrefined grid's quads; a round that would exceed it is retried with
+  // the worse half of its places (down to one), then refinement stops.
+  double max_growth = 1.3;
+  // Threads for the distance queries and the map's values at P's vertices (the map must then be
+  // thread-safe); 0: one per hardware thread, 1: the calling thread.
+  int threads = 1;
+};
+
+// Preimages under a map P → M of points near M, through the map's chords: the images of P's
+// vertices span a triangle mesh with P's triangles; a point's closest point on it, with its
+// barycentric coordinates, is the same triangle and coordinates of P.
+class PreimageLocator {
+ public:
+  // to_model is evaluated at every vertex of P (threads as in QuadRefineOptions).
+  PreimageLocator(const TriMesh& polycube, const SurfaceMap& to_model, int threads);
+  // The point of P whose chord image is closest to x.
+  SurfacePoint preimage(const Eigen::Vector3d& x) const;
+  // The closest point of P to p (p on P up to rounding).
+  SurfacePoint on_polycube(const Eigen::Vector3d& p) const;
+
+ private:
+  TriMesh polycube_;
+  TriMesh images_;
+  std::unique_ptr<SurfaceProjector> on_polycube_;
+  std::unique_ptr<SurfaceProjector> on_images_;
+};
+
+// Where quads on M (the grid carried, perhaps relaxed: same connectivity) miss M by more than
+// `distance`:
+//   points    points of P to refine at, the worst first: the preimages of the points of M
+//             farther than `distance` from the quads (two triangles each) — M's vertices, and the
+//             centroids and edge midpoints of M's triangles longer than cell_size / 4 (a coarse
+//             CAD mesh is missed inside its triangles) — and the centres on P of quads whose
+//             centre on M is farther than `distance` from M
+//   distances their distances
+//   farthest  the largest of both distances (whether or not above `distance`)
+struct QuadMiss {
+  std::vector<SurfacePoint> points;
+  std::vector<double> distances;  // per point, descending
+  double farthest = 0;
+};
+QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model,
+                          const PreimageLocator& locator, double distance, double cell_size, int threads);
+
+}  // namespace polycube
