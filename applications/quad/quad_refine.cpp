@@ -18,6 +18,13 @@ SurfacePoint surface_point(const TriMesh& mesh, int f, const Eigen::Vector3d& x)
   SurfacePoint point;
   point.face = f;
   point.bary = closest.bary;
+  if (!point.bary.allFinite()) {  // a degenerate image triangle: its corner nearest x
+    int nearest = 0;
+    for (int i = 1; i < 3; ++i)
+      if ((mesh.V.row(mesh.F(f, i)).transpose() - x).squaredNorm() < (mesh.V.row(mesh.F(f, nearest)).transpose() - x).squaredNorm())
+        nearest = i;
+    point.bary = Eigen::Vector3d::Unit(nearest);
+  }
   return point;
 }
 }  // namespace
