@@ -463,7 +463,7 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));
   command->add_option("--polycube-vertices", options->polycube.target_vertices,
-                      "About how many vertices the triangulated polycube gets (0: as many as the model)")
+                      "About how many vertices the triangulated polycube gets (0: as many as the model; under 5000, --align auto also tries 20000)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   command->add_option("--align", options->align,

@@ -248,7 +248,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     add_frame(2);
     score(first);
   }
-  const int n = static_cast<int>(out.candidates.size());
+  int n = static_cast<int>(out.candidates.size());
   // The few with the fewest corners get their map built and audited (vertex-sampled flips both
   // ways, ε_angle): corners alone do not tell a good map from a bad one.
   std::vector<int> mapped;
@@ -280,6 +280,49 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     bool clean = false;
     for (size_t k = 0; k < first; ++k) clean = clean || (maps[mapped[k]] && out.candidates[mapped[k]].flipped == 0);
     if (!clean && first < mapped.size()) map_candidates(std::vector<int>(mapped.begin() + first, mapped.end()));
+  }
+  // A model with few vertices: the mapped candidates once more with a finer P (the same topology
+  // and polycube, triangulated with at least fine_polycube_vertices vertices), as further
+  // candidates. The map's harmonic maps live on P's triangulation; P as fine as a coarse model is
+  // often too coarse for a smooth map, but not always worse (bench/map.md), so both compete.
+  if (options.fine_polycube_vertices > 0 && polycube.target_vertices == 0 && !use_proxy &&
+      scored.num_vertices() < options.coarse_below && options.fine_polycube_vertices > scored.num_vertices()) {
+    PolycubeOptions finer = scoring;
+    finer.min_vertices = std::max(polycube.min_vertices, options.fine_polycube_vertices);
+    std::vector<int> variants;
+    for (int i = 0; i < n; ++i) {
+      if (!maps[i]) continue;
+      AlignmentCandidate c = out.candidates[i];
+      c.name += ", finer P";
+      c.flipped = -1;
+      c.eps_angle = -1;
+      c.error.clear();
+      variants.push_back(static_cast<int>(out.candidates.size()));
+      out.candidates.push_back(c);
+      topologies.push_back(topologies[i]);
+      turned.push_back(turned[i]);
+      polycubes.push_back(nullptr);
+      maps.push_back(nullptr);
+    }
+    parallel_for_each(variants, options.threads, "orientation", [&](int j) {
+      AlignmentCandidate& c = out.candidates[j];
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        polycubes[j] = std::make_shared<PolycubeResult>(build_polycube(turned[j], *topologies[j], finer));
+        c.corners = static_cast<int>(polycubes[j]->polycube.corners.size());
+      } catch (const Error& e) {
+        c.error = e.what();
+        polycubes[j].reset();
+      }
+      c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    });
+    std::vector<int> built;
+    for (int j : variants)
+      if (polycubes[j]) built.push_back(j);
+    map_candidates(built);
+    for (int j : variants)
+      if (!maps[j]) polycubes[j].reset();  // a variant competes only with its map
+    n = static_cast<int>(out.candidates.size());
   }
   // Fewest flips, then least ε_angle, then fewest corners, then the earlier candidate.
   auto key = [&](int i) {

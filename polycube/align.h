@@ -100,6 +100,11 @@ struct AlignmentOptions {
   // (the fewest corners win) and, if none passes, with the caller's full budget, in order, until
   // one succeeds (chosen is then that one, with its topology and polycube but no map).
   bool full_budget_fallback = true;
+  // A model with fewer vertices than coarse_below (and no target_vertices asked for) also tries
+  // its mapped candidates with P triangulated by at least fine_polycube_vertices vertices; the
+  // map with the fewest flips still wins. 0: never.
+  int coarse_below = 5000;
+  int fine_polycube_vertices = 20000;
 };
 
 // Scores the candidates (input frame / principal axes / normal axes × which axis is z); see the

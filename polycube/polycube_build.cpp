@@ -448,7 +448,8 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
   // quadtrees fail the final check (the slab checks are combinatorial, the final one is not),
   // P is built again from the quadtrees as the repairs left them.
   PolycubeSurfaceOptions surface_options;
-  surface_options.target_vertices = options.target_vertices > 0 ? options.target_vertices : model.num_vertices();
+  surface_options.target_vertices =
+      options.target_vertices > 0 ? options.target_vertices : std::max(model.num_vertices(), options.min_vertices);
   surface_options.avoid_z = sliced.planes;
   PolycubeVerification verification;
   const std::vector<std::vector<QuadLeaf>>* attempts[2] = {&final_leaves, &refined_leaves};

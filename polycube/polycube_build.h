@@ -24,8 +24,9 @@ struct PolycubeOptions {
   int max_level = 10;
   // Deepest quadtree level topology repairs may subdivide to (at most kQuadGridBits = 20).
   int max_repair_level = 18;
-  // About how many vertices P's mesh gets; 0: as many as the model has.
+  // About how many vertices P's mesh gets; 0: as many as the model has, at least min_vertices.
   int target_vertices = 0;
+  int min_vertices = 0;
   // Per slab, how many times the quadtree cells where a failing slab's regions meet may be
   // subdivided (only when the finely sampled contours pass the slab's check, i.e. subdivision
   // can repair it) before a plane is inserted in the middle of the slab instead. More attempts
