@@ -182,7 +182,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     alignment = choose_alignment(prepared.mesh, options.topology, options.polycube);
     nlohmann::json candidates = nlohmann::json::array();
     for (const AlignmentCandidate& c : alignment.candidates)
-      candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle},
+      candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle}, {"eps_area", c.eps_area},
                             {"fallback_budget", c.fallback_budget}, {"seconds", c.seconds}, {"error", c.error}});
     report["alignment"]["candidates"] = candidates;
     report["alignment"]["proxy_faces"] = alignment.proxy_faces;

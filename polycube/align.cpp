@@ -266,6 +266,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
         c.flipped = audit.polycube_to_model.flipped + audit.model_to_polycube.flipped + audit.polycube_to_model.degenerate +
                     audit.model_to_polycube.degenerate;
         c.eps_angle = audit.distortion.eps_angle;
+        c.eps_area = audit.distortion.eps_area;
       } catch (const Error& e) {
         c.error = e.what();
         maps[i].reset();
@@ -296,6 +297,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       c.name += ", finer P";
       c.flipped = -1;
       c.eps_angle = -1;
+      c.eps_area = -1;
       c.error.clear();
       variants.push_back(static_cast<int>(out.candidates.size()));
       out.candidates.push_back(c);

@@ -26,7 +26,7 @@ namespace polycube {
 
 // One orientation tried: x_aligned = rotation * x_input (a proper rotation).
 //   corners  of the polycube built in it (-1 if the stages failed there, see error)
-//   flipped, eps_angle  of its map before smoothing, both directions (-1 if not mapped)
+//   flipped, eps_angle, eps_area  of its map before smoothing, both directions (-1 if not mapped)
 //   fallback_budget  its polycube was built by the fallback (no candidate passed the scoring
 //            budget): four times that budget, or the caller's full one
 struct AlignmentCandidate {
@@ -35,6 +35,7 @@ struct AlignmentCandidate {
   int corners = -1;
   int flipped = -1;
   double eps_angle = -1;
+  double eps_area = -1;
   bool fallback_budget = false;
   double seconds = 0;
   std::string error;
