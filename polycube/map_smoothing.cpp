@@ -52,34 +52,14 @@ Vec3 normalized_bary(const Vec3& w) {
 
 using Closest = TriangleClosest;
 
-// Compressed lists: the items of key k are items[begin[k] .. begin[k + 1]).
-struct Lists {
-  std::vector<int> begin, items;
-  Lists() = default;
-  Lists(int keys, const std::vector<std::pair<int, int>>& pairs) : begin(keys + 1, 0), items(pairs.size()) {
-    for (const auto& pair : pairs) ++begin[pair.first + 1];
-    for (int k = 0; k < keys; ++k) begin[k + 1] += begin[k];
-    std::vector<int> at(begin.begin(), begin.end() - 1);
-    for (const auto& [k, i] : pairs) items[at[k]++] = i;
-  }
-  const int* first(int k) const { return items.data() + begin[k]; }
-  const int* last(int k) const { return items.data() + begin[k + 1]; }
-};
-
-Lists vertex_faces(const TriMesh& mesh) {
-  std::vector<std::pair<int, int>> pairs;
-  pairs.reserve(3 * mesh.num_faces());
-  for (int f = 0; f < mesh.num_faces(); ++f)
-    for (int i = 0; i < 3; ++i) pairs.emplace_back(mesh.F(f, i), f);
-  return Lists(mesh.num_vertices(), pairs);
-}
+using Lists = CompressedLists;
 
 // ---------------------------------------------------------------------------------------------
 // A closed triangle mesh with what the smoothing asks of it: adjacency across edges, intrinsic
 // angle sums, normals, and local closest points.
 class Surface {
  public:
-  explicit Surface(const TriMesh& mesh) : mesh_(mesh), faces_of_(vertex_faces(mesh)) {
+  explicit Surface(const TriMesh& mesh) : mesh_(mesh), faces_of_(vertex_faces(mesh.F, mesh.num_vertices())) {
     const int nv = mesh.num_vertices(), nf = mesh.num_faces();
     if (nf == 0) throw std::invalid_argument("smooth_map: a mesh has no faces");
     const EdgeMap edges = build_edge_map(mesh.F);

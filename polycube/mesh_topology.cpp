@@ -129,26 +129,34 @@ int connected_components(const Eigen::MatrixX3i& F, int num_vertices, Eigen::Vec
   return static_cast<int>(ids.size());
 }
 
+CompressedLists::CompressedLists(int keys, const std::vector<std::pair<int, int>>& pairs)
+    : begin(keys + 1, 0), items(pairs.size()) {
+  for (const auto& pair : pairs) ++begin[pair.first + 1];
+  for (int k = 0; k < keys; ++k) begin[k + 1] += begin[k];
+  std::vector<int> at(begin.begin(), begin.end() - 1);
+  for (const auto& [k, i] : pairs) items[at[k]++] = i;
+}
+
+CompressedLists vertex_faces(const Eigen::MatrixX3i& F, int num_vertices) {
+  std::vector<std::pair<int, int>> pairs;
+  pairs.reserve(3 * F.rows());
+  for (int f = 0; f < F.rows(); ++f)
+    for (int i = 0; i < 3; ++i) pairs.emplace_back(F(f, i), f);
+  return CompressedLists(num_vertices, pairs);
+}
+
 int count_nonmanifold_vertices(const Eigen::MatrixX3i& F, int num_vertices) {
   // Around each vertex, faces sharing an edge through the vertex are linked; a manifold vertex
-  // has exactly one linked group of faces. Faces round each vertex in CSR form.
-  std::vector<int> start(num_vertices + 1, 0);
-  for (int f = 0; f < F.rows(); ++f)
-    for (int i = 0; i < 3; ++i) ++start[F(f, i) + 1];
-  for (int v = 0; v < num_vertices; ++v) start[v + 1] += start[v];
-  std::vector<int> faces_at(start.back());
-  std::vector<int> next(start.begin(), start.end() - 1);
-  for (int f = 0; f < F.rows(); ++f)
-    for (int i = 0; i < 3; ++i) faces_at[next[F(f, i)]++] = f;
-
+  // has exactly one linked group of faces.
+  const CompressedLists faces_at = vertex_faces(F, num_vertices);
   int bad = 0;
   std::vector<std::pair<int, int>> by_neighbour;  // (other end of an edge through v, local face)
   for (int v = 0; v < num_vertices; ++v) {
-    const int count = start[v + 1] - start[v];
+    const int count = faces_at.count(v);
     if (count <= 1) continue;
     by_neighbour.clear();
     for (int k = 0; k < count; ++k) {
-      const int f = faces_at[start[v] + k];
+      const int f = faces_at.first(v)[k];
       for (int i = 0; i < 3; ++i)
         if (F(f, i) != v) by_neighbour.emplace_back(F(f, i), k);
     }

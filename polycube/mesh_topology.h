@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <utility>
 #include <vector>
 
 namespace polycube {
@@ -26,6 +27,21 @@ struct EdgeMap {
 };
 
 EdgeMap build_edge_map(const Eigen::MatrixX3i& F);
+
+// Lists in one array (compressed rows): the items of key k are items[begin[k] .. begin[k + 1]),
+// in the order the (key, item) pairs were given.
+struct CompressedLists {
+  std::vector<int> begin, items;
+  CompressedLists() = default;
+  // pairs: (key in 0..keys-1, item).
+  CompressedLists(int keys, const std::vector<std::pair<int, int>>& pairs);
+  const int* first(int k) const { return items.data() + begin[k]; }
+  const int* last(int k) const { return items.data() + begin[k + 1]; }
+  int count(int k) const { return begin[k + 1] - begin[k]; }
+};
+
+// The faces round each vertex, in increasing order.
+CompressedLists vertex_faces(const Eigen::MatrixX3i& F, int num_vertices);
 
 // How the faces meet along the edges: edges with one face (boundary), with more than two
 // (non-manifold), and with two faces running through them in the same direction (inconsistently

@@ -1,6 +1,7 @@
 #include "applications/quad/quad_refine.h"
 
 #include "polycube/closest_point.h"
+#include "polycube/errors.h"
 #include "polycube/parallel.h"
 
 #include <algorithm>
@@ -30,7 +31,7 @@ SurfacePoint surface_point(const TriMesh& mesh, int f, const Eigen::Vector3d& x)
 }  // namespace
 
 PreimageLocator::PreimageLocator(const TriMesh& polycube, const SurfaceMap& to_model, int threads)
-    : polycube_(polycube), on_polycube_(std::make_unique<SurfaceProjector>(polycube)) {
+    : on_polycube_(std::make_unique<SurfaceProjector>(polycube)) {
   const int nv = polycube.num_vertices();
   std::vector<SurfacePoint> at_vertex(nv);
   for (int f = 0; f < polycube.num_faces(); ++f)
@@ -39,26 +40,25 @@ PreimageLocator::PreimageLocator(const TriMesh& polycube, const SurfaceMap& to_m
       p.face = f;
       p.bary = Eigen::Vector3d::Unit(i);
     }
-  images_.F = polycube.F;
-  images_.V.resize(nv, 3);
+  TriMesh images;
+  images.F = polycube.F;
+  images.V.resize(nv, 3);
   parallel_range(nv, threads, [&](int v) {
     if (at_vertex[v].face >= 0)
-      images_.V.row(v) = to_model(at_vertex[v]).transpose();
+      images.V.row(v) = to_model(at_vertex[v]).transpose();
     else
-      images_.V.row(v) = polycube.V.row(v);  // on no triangle: never a closest point's corner that matters
+      images.V.row(v) = polycube.V.row(v);  // on no triangle: never a closest point's corner
   });
-  if (!images_.V.allFinite()) throw AlgorithmError("the map sends a vertex of P to a non-finite point");
-  on_images_ = std::make_unique<SurfaceProjector>(images_);
+  if (!images.V.allFinite()) throw AlgorithmError("the map sends a vertex of P to a non-finite point");
+  on_images_ = std::make_unique<SurfaceProjector>(images);
 }
 
 SurfacePoint PreimageLocator::preimage(const Eigen::Vector3d& x) const {
-  const int f = on_images_->closest(x).face;
-  SurfacePoint point = surface_point(images_, f, x);
-  return point;
+  return surface_point(on_images_->surface(), on_images_->closest(x).face, x);
 }
 
 SurfacePoint PreimageLocator::on_polycube(const Eigen::Vector3d& p) const {
-  return surface_point(polycube_, on_polycube_->closest(p).face, p);
+  return surface_point(on_polycube_->surface(), on_polycube_->closest(p).face, p);
 }
 
 QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model,

@@ -50,10 +50,8 @@ class PreimageLocator {
   SurfacePoint on_polycube(const Eigen::Vector3d& p) const;
 
  private:
-  TriMesh polycube_;
-  TriMesh images_;
-  std::unique_ptr<SurfaceProjector> on_polycube_;
-  std::unique_ptr<SurfaceProjector> on_images_;
+  std::unique_ptr<SurfaceProjector> on_polycube_;  // P (its copy of P is the one used)
+  std::unique_ptr<SurfaceProjector> on_images_;  // P's triangles at their vertices' images
 };
 
 // Where quads on M (the grid carried, perhaps relaxed: same connectivity) miss M by more than

@@ -127,15 +127,15 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         grid_options.refine_rounds.pop_back();  // not better: this round's places are not refined again
         break;
       }
-      // Stage times stay the first pass's; the refinement's (its passes included) is apart.
-      pass.seconds_carry = result.seconds_carry;
-      pass.seconds_smooth = result.seconds_smooth;
-      pass.seconds_fit = result.seconds_fit;
-      pass.seconds_grid = result.seconds_grid;
-      pass.refine_miss_before = result.refine_miss_before;
-      pass.refine_miss_after = next.farthest;
-      pass.refine_rounds = round + 1;
-      result = std::move(pass);
+      // The round's quads are kept; the stage times stay the first pass's (the refinement's,
+      // its passes included, is apart).
+      result.grid = std::move(pass.grid);
+      result.mesh = std::move(pass.mesh);
+      result.smoothing = std::move(pass.smoothing);
+      result.fitting = std::move(pass.fitting);
+      result.refitting = std::move(pass.refitting);
+      result.refine_miss_after = next.farthest;
+      result.refine_rounds = round + 1;
       best_bad = pass_bad;
       miss = next;
     }

@@ -56,7 +56,7 @@ struct SurfaceProjector::Impl {
   // For the walks of closest_on_sheet: the face across each edge of a face (-1: none), the faces
   // round each vertex (CSR).
   Eigen::MatrixX3i across;
-  std::vector<int> ring_start, ring;
+  CompressedLists ring;
 
   // The hit for a query whose closest point on the surface is `point`, on triangle `face`.
   SurfaceHit hit(const Eigen::Vector3d& query, const Eigen::Vector3d& point, int face) const;
@@ -94,14 +94,7 @@ SurfaceProjector::SurfaceProjector(const TriMesh& surface) : impl_(std::make_uni
       const int other = edges.EF(e, 0) == f ? edges.EF(e, 1) : edges.EF(e, 0);
       impl_->across(f, i) = edges.face_count[e] == 2 ? other : -1;
     }
-  impl_->ring_start.assign(surface.num_vertices() + 1, 0);
-  for (int f = 0; f < surface.num_faces(); ++f)
-    for (int i = 0; i < 3; ++i) ++impl_->ring_start[surface.F(f, i) + 1];
-  for (int v = 0; v < surface.num_vertices(); ++v) impl_->ring_start[v + 1] += impl_->ring_start[v];
-  impl_->ring.resize(impl_->ring_start.back());
-  std::vector<int> filled(impl_->ring_start.begin(), impl_->ring_start.end() - 1);
-  for (int f = 0; f < surface.num_faces(); ++f)
-    for (int i = 0; i < 3; ++i) impl_->ring[filled[surface.F(f, i)]++] = f;
+  impl_->ring = vertex_faces(surface.F, surface.num_vertices());
 }
 
 SurfaceProjector::~SurfaceProjector() = default;
@@ -158,7 +151,7 @@ SurfaceHit SurfaceProjector::closest_on_sheet(const Eigen::Vector3d& query, cons
       consider(impl_->across(face, (zero + 1) % 3));  // on the edge opposite corner `zero`
     } else {
       const int v = m.F(face, nonzero);  // at that corner
-      for (int k = impl_->ring_start[v]; k < impl_->ring_start[v + 1]; ++k) consider(impl_->ring[k]);
+      for (const int* g = impl_->ring.first(v); g != impl_->ring.last(v); ++g) consider(*g);
     }
     if (next < 0) break;
     face = next;

@@ -237,7 +237,9 @@ void expect_valid_grid(const TriMesh& P, const PolycubeGrid& grid, bool equal_pa
       if (std::abs(edge - side / grid.cell_parts(s, k % 2)) > 1e-12 * diagonal) ++wrong_size;
     }
   }
-  if (equal_parts) EXPECT_EQ(wrong_size, 0);
+  if (equal_parts) {
+    EXPECT_EQ(wrong_size, 0);
+  }
   for (int s = 0; s < grid.layout.num_quads(); ++s) EXPECT_EQ(per_cell[s], grid.cell_parts(s, 0) * grid.cell_parts(s, 1));
   for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::is_sorted(grid.levels[a].begin(), grid.levels[a].end()));
   for (int q = 0; q < nq; ++q) {
