@@ -24,6 +24,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 namespace polycube::cli {
 
@@ -124,6 +125,31 @@ struct Finished {
   MapAudit audit;
   int bad_p() const { return audit.polycube_to_model.flipped + audit.polycube_to_model.degenerate; }
   int bad_m() const { return audit.model_to_polycube.flipped + audit.model_to_polycube.degenerate; }
+  // What `map` promises (issue 5): no flipped or degenerate image triangle either way, images on
+  // the surfaces, P's image covering the model's area to the audit's 2 %. (The model's image on P
+  // is not held to an area: on a coarse model its triangles are chords across P's edges.)
+  bool meets_contract() const {
+    return bad_p() == 0 && bad_m() == 0 && audit.polycube_to_model.ok &&
+           audit.model_to_polycube.max_distance <= MapAuditOptions().surface_tolerance;
+  }
+};
+
+// One orientation's stages, from the topology to the finished map (those the orientation search
+// built come with it). Heap-held: finished points into refinement or polycube.
+struct Attempt {
+  int candidate = -1;  // in Alignment::candidates; -1 with --align none
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  TriMesh model;  // turned by rotation
+  std::shared_ptr<TopologyResult> topology;
+  std::shared_ptr<PolycubeResult> polycube;
+  std::shared_ptr<PolycubeMap> map;
+  std::unique_ptr<MapRefinementResult> refinement;  // P's sampling refined before the smoothing
+  std::unique_ptr<Finished> finished;               // after it: the P and sampling written
+  nlohmann::json refinement_report = nullptr;
+  double refine_seconds = 0, smooth_unrefined_seconds = 0, seconds = 0;
+  // Finished maps compare by flipped + degenerate triangles both ways, then whether they meet
+  // the contract (surface distance and P's image area), then ε_angle.
+  std::tuple<int, int, double> finished_rank;
 };
 
 nlohmann::json polycube_json(const PolycubeResult& result) {
@@ -152,6 +178,157 @@ nlohmann::json polycube_json(const PolycubeResult& result) {
                        {"surface", result.seconds_surface},
                        {"verify", result.seconds_verify},
                        {"total", result.seconds_total}}}};
+}
+
+nlohmann::json direction_json(const MapDirectionAudit& a) {
+  return nlohmann::json{{"triangles", a.triangles}, {"flipped", a.flipped}, {"degenerate", a.degenerate},
+                        {"max_distance", a.max_distance}, {"area_ratio", a.area_ratio}, {"ok", a.ok}};
+}
+
+nlohmann::json refinement_json(const MapRefinementResult& r) {
+  auto side = [](const MapDirectionAudit& a) {
+    return nlohmann::json{{"flipped", a.flipped}, {"degenerate", a.degenerate}, {"area_ratio", a.area_ratio}};
+  };
+  return nlohmann::json{{"refined", r.refined},       {"converged", r.converged},
+                        {"rounds", r.rounds},         {"bisections", r.bisections},
+                        {"vertices_before", r.vertices_before}, {"vertices_after", r.vertices_after},
+                        {"triangles_before", r.triangles_before}, {"triangles_after", r.triangles_after},
+                        {"before", side(r.before)},   {"after", side(r.after)},
+                        {"model_to_polycube_before", side(r.model_to_polycube_before)},
+                        {"model_to_polycube_after", side(r.model_to_polycube_after)},
+                        {"model_to_polycube_rejected", r.model_to_polycube_rejected},
+                        {"frozen_faces", r.frozen_faces},
+                        {"seconds", r.seconds}};
+}
+
+std::string refinement_line(const MapRefinementResult& r) {
+  std::ostringstream line;
+  line << r.vertices_before << " -> " << r.vertices_after << " vertices in " << r.rounds << " rounds; P to M flipped "
+       << r.before.flipped + r.before.degenerate << " -> " << r.after.flipped + r.after.degenerate << ", image area "
+       << std::fixed << std::setprecision(4) << r.before.area_ratio << " -> " << r.after.area_ratio;
+  return line.str();
+}
+
+// Stage 5 (§3.5) on a given P and sampling: the smoothing, which never adds a flip in either
+// direction, then the second refinement of P's sampling; the audit of the result.
+std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<double>& planes_z, const Polycube& P,
+                                     const PolycubeMap& sampled, const MapOptions& options, const Progress& progress) {
+  auto out = std::make_unique<Finished>();
+  out->polycube = &P;
+  out->on_model_xyz = sampled.polycube_on_model_xyz;
+  out->on_polycube_xyz = sampled.model_on_polycube_xyz;
+  if (options.smooth_sweeps > 0) {
+    progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded");
+    // smooth_map audits its input itself (flipped_before); the distortion before is cheap.
+    const DistortionStats before = map_distortion(P.mesh, out->on_model_xyz);
+    MapSmoothingOptions smooth_options;
+    smooth_options.sweeps = options.smooth_sweeps;
+    const MapSmoothingResult smoothed = smooth_map(model, P, sampled, smooth_options);
+    out->on_model_xyz = smoothed.polycube_on_model_xyz;
+    out->on_polycube_xyz = smoothed.model_on_polycube_xyz;
+    out->smooth_seconds = smoothed.seconds;
+    out->smoothing = {{"sweeps", smoothed.sweeps},
+                      {"rounds", smoothed.rounds},
+                      {"moves", smoothed.moves},
+                      {"rejected", smoothed.rejected},
+                      {"frozen_polycube_vertices", smoothed.frozen},
+                      {"relocated_model_vertices", smoothed.relocated},
+                      {"seconds", smoothed.seconds},
+                      {"before", {{"polycube_to_model_flipped", smoothed.flipped_before[0]},
+                                  {"model_to_polycube_flipped", smoothed.flipped_before[1]},
+                                  {"eps_angle", before.eps_angle},
+                                  {"eps_area", before.eps_area},
+                                  {"angle_p95", before.angle_p95},
+                                  {"angle_max", before.angle_max}}}};
+    progress.stage("smooth", std::to_string(smoothed.flipped_before[0]) + " / " + std::to_string(smoothed.flipped_before[1]) +
+                                 " flipped before, " + std::to_string(smoothed.flipped_after[0]) + " / " +
+                                 std::to_string(smoothed.flipped_after[1]) + " after");
+    if (options.refine) {
+      progress.stage("refine", "again where the smoothed map's chords flip or lose area");
+      PolycubeMap samples;
+      samples.polycube_on_model = smoothed.polycube_on_model;
+      samples.polycube_on_model_xyz = smoothed.polycube_on_model_xyz;
+      samples.model_on_polycube = smoothed.model_on_polycube;
+      samples.model_on_polycube_xyz = smoothed.model_on_polycube_xyz;
+      // Nothing moves the images after this: refine only where the audit's 2 % is not met
+      // (it then aims at half of that).
+      MapRefinementOptions resample_options;
+      resample_options.area_tolerance = MapAuditOptions().area_tolerance;
+      out->resampling = std::make_unique<MapRefinementResult>(refine_vertex_map_sampling(model, P, planes_z, samples, resample_options));
+      out->polycube = &out->resampling->polycube;
+      out->on_model_xyz = out->resampling->map.polycube_on_model_xyz;
+      out->on_polycube_xyz = out->resampling->map.model_on_polycube_xyz;
+      out->resample_seconds = out->resampling->seconds;
+      out->resampling_report = refinement_json(*out->resampling);
+      progress.stage("refine", refinement_line(*out->resampling));
+    }
+  }
+  out->audit = audit_map(model, out->polycube->mesh, out->on_model_xyz, out->on_polycube_xyz);
+  return out;
+}
+
+// The stages of one orientation that the search did not build (all of them with --align none),
+// up to the stage asked; with the map, its refinement and finish. P's sampling of φ is refined
+// where its chords flip or lose area (issue 5) before the smoothing (φ itself at the new
+// vertices) and after it (the smoothed chords projected on the model): P's surface stays the
+// same, its triangulation gets finer, and every later step and file uses the refined one.
+void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, const Progress& progress) {
+  const double start = progress.elapsed_seconds();
+  a.model = rotated(input, a.rotation);
+  progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
+  if (!a.topology) a.topology = std::make_shared<TopologyResult>(analyse_topology(a.model, options.topology));
+  progress.stage("topology", std::to_string(a.topology->critical.saddle_count()) + " saddles, " +
+                                 std::to_string(a.topology->planes_z.size()) + " planes, " +
+                                 std::to_string(a.topology->sliced.pieces.size()) + " genus-0 pieces");
+  if (runs(options.stage, "polycube")) {
+    progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
+    if (!a.polycube) a.polycube = std::make_shared<PolycubeResult>(build_polycube(a.model, *a.topology, options.polycube));
+    for (const std::string& repair : a.polycube->repairs) progress.warning("polycube: " + repair);
+    progress.stage("polycube", std::to_string(a.polycube->polycube.corners.size()) + " corners, " +
+                                   std::to_string(a.polycube->polycube.faces.size()) + " faces, " +
+                                   std::to_string(a.polycube->polycube_sliced.pieces.size()) + " pieces matched");
+  }
+  if (runs(options.stage, "map")) {
+    progress.stage("map", "boundary maps, slits, disk maps of " + std::to_string(a.polycube->piece_match.size()) + " piece pairs");
+    if (!a.map) a.map = std::make_shared<PolycubeMap>(build_polycube_map(a.model, *a.polycube));
+    const std::vector<double>& planes_z = a.polycube->planes_z;
+    if (!options.refine) {
+      a.finished = finish_map(a.model, planes_z, a.polycube->polycube, *a.map, options, progress);
+    } else {
+      progress.stage("refine", "bisecting P's triangles where the map sampled at its vertices flips or loses area");
+      a.refinement = std::make_unique<MapRefinementResult>(refine_map_sampling(a.model, *a.polycube, *a.map));
+      const MapRefinementResult& refinement = *a.refinement;
+      progress.stage("refine", refinement_line(refinement));
+      a.refinement_report = {{"map", refinement_json(refinement)}};
+      a.refine_seconds = refinement.seconds;
+      std::unique_ptr<Finished> refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
+      a.refine_seconds += refined->resample_seconds;
+      a.refinement_report["smoothed"] = refined->resampling_report;
+      if (refinement.refined) {
+        // The smoothing of a refined sampling can end worse than that of the unrefined one (it
+        // is a different problem): the refined result is kept only if neither direction has
+        // more bad triangles, or both together have fewer, than the unrefined P's result.
+        progress.stage("refine", "comparing with the unrefined P's smoothed map");
+        std::unique_ptr<Finished> unrefined = finish_map(a.model, planes_z, a.polycube->polycube, *a.map, options, progress);
+        a.refine_seconds += unrefined->resample_seconds;
+        const bool keep = (refined->bad_p() <= unrefined->bad_p() && refined->bad_m() <= unrefined->bad_m()) ||
+                          refined->bad_p() + refined->bad_m() < unrefined->bad_p() + unrefined->bad_m();
+        a.refinement_report["kept"] = keep;
+        a.refinement_report["unrefined"] = {{"polycube_to_model", direction_json(unrefined->audit.polycube_to_model)},
+                                            {"model_to_polycube", direction_json(unrefined->audit.model_to_polycube)},
+                                            {"smoothed", unrefined->resampling_report}};
+        a.smooth_unrefined_seconds = unrefined->smooth_seconds;
+        progress.stage("refine", std::string(keep ? "kept" : "dropped") + " (refined P " + std::to_string(refined->bad_p()) + " / " +
+                                     std::to_string(refined->bad_m()) + " flipped, unrefined P " + std::to_string(unrefined->bad_p()) +
+                                     " / " + std::to_string(unrefined->bad_m()) + ")");
+        a.finished = keep ? std::move(refined) : std::move(unrefined);
+      } else {
+        a.refinement_report["kept"] = false;
+        a.finished = std::move(refined);
+      }
+    }
+  }
+  a.seconds = progress.elapsed_seconds() - start;
 }
 
 int run_map(const MapOptions& options, const GlobalOptions& global) {
@@ -199,10 +376,72 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
     }
   }
+  // One orientation, from its topology to its finished map; a finished map that does not meet the
+  // contract (Finished::meets_contract) tries the search's next candidates
+  // (Alignment::alternatives) and keeps the best.
+  std::vector<std::unique_ptr<Attempt>> attempts;
+  auto first = std::make_unique<Attempt>();
+  first->candidate = alignment.chosen;
+  first->rotation = rotation;
+  first->topology = alignment.topology;
+  first->polycube = alignment.polycube;
+  first->map = alignment.map;
+  attempts.push_back(std::move(first));
+  if (runs(options.stage, "map"))
+    for (const AlignedStages& a : alignment.alternatives) {
+      auto next = std::make_unique<Attempt>();
+      next->candidate = a.candidate;
+      next->rotation = alignment.candidates[a.candidate].rotation;
+      next->topology = a.topology;
+      next->polycube = a.polycube;
+      next->map = a.map;
+      attempts.push_back(std::move(next));
+    }
+  Attempt* kept = nullptr;
+  for (std::unique_ptr<Attempt>& attempt : attempts) {
+    Attempt& a = *attempt;
+    if (kept) {
+      progress.stage("retry", "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " +
+                                  std::to_string(kept->finished->bad_m()) + " flipped, image area " +
+                                  std::to_string(kept->finished->audit.polycube_to_model.area_ratio) +
+                                  "; finishing the next orientation candidate, " + alignment.candidates[a.candidate].name);
+    }
+    run_stages(a, prepared.mesh, options, progress);
+    if (!a.finished) {
+      kept = &a;
+      break;
+    }
+    a.finished_rank = std::make_tuple(a.finished->bad_p() + a.finished->bad_m(), a.finished->meets_contract() ? 0 : 1,
+                                      a.finished->audit.distortion.eps_angle);
+    if (!kept || a.finished_rank < kept->finished_rank) kept = &a;
+    if (kept->finished->meets_contract()) break;
+  }
+  Attempt& chosen = *kept;
+  rotation = chosen.rotation;
+  if (chosen.candidate >= 0 && chosen.candidate != alignment.chosen) {
+    report["alignment"]["chosen"] = alignment.candidates[chosen.candidate].name;
+    progress.stage("retry", "kept " + alignment.candidates[chosen.candidate].name);
+  }
+  if (attempts.size() > 1) {
+    nlohmann::json finished = nlohmann::json::array();
+    for (const std::unique_ptr<Attempt>& a : attempts) {
+      if (!a->finished) continue;
+      finished.push_back({{"name", alignment.candidates[a->candidate].name},
+                          {"polycube_to_model_flipped", a->finished->bad_p()},
+                          {"model_to_polycube_flipped", a->finished->bad_m()},
+                          {"area_ratio", a->finished->audit.polycube_to_model.area_ratio},
+                          {"eps_angle", a->finished->audit.distortion.eps_angle},
+                          {"eps_area", a->finished->audit.distortion.eps_area},
+                          {"meets_contract", a->finished->meets_contract()},
+                          {"kept", a.get() == kept},
+                          {"seconds", a->seconds}});
+    }
+    report["alignment"]["finished"] = finished;
+  }
   report["alignment"]["rotation"] = {{rotation(0, 0), rotation(0, 1), rotation(0, 2)},
                                      {rotation(1, 0), rotation(1, 1), rotation(1, 2)},
                                      {rotation(2, 0), rotation(2, 1), rotation(2, 2)}};
-  const TriMesh model = rotated(prepared.mesh, rotation);
+  const TriMesh& model = chosen.model;
   // Positions of the turned frame back in the input's (x = rotation^T x_turned).
   auto to_input = [&rotation](const Eigen::MatrixX3d& V) -> Eigen::MatrixX3d { return V * rotation; };
   auto mesh_to_input = [&](const TriMesh& m) {
@@ -210,41 +449,33 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     out.V = to_input(m.V);
     return out;
   };
-
-  progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
-  const TopologyResult topology = alignment.topology ? std::move(*alignment.topology) : analyse_topology(model, options.topology);
+  const TopologyResult& topology = *chosen.topology;
   report["topology"] = topology_json(topology);
-  progress.stage("topology", std::to_string(topology.critical.saddle_count()) + " saddles, " +
-                                 std::to_string(topology.planes_z.size()) + " planes, " +
-                                 std::to_string(topology.sliced.pieces.size()) + " genus-0 pieces");
   nlohmann::json seconds = {{"align", align_seconds}, {"topology", topology.seconds_total}};
+  if (attempts.size() > 1) {
+    double retry_seconds = 0;
+    for (const std::unique_ptr<Attempt>& a : attempts)
+      if (a.get() != kept) retry_seconds += a->seconds;
+    seconds["retry"] = retry_seconds;
+  }
   const SlicedMesh* model_pieces = &topology.sliced;
-  std::optional<PolycubeResult> polycube;
-  std::optional<PolycubeMap> map;
-  std::optional<MapRefinementResult> refinement;  // P's sampling refined before the smoothing
-  std::unique_ptr<Finished> finished;              // after it: the P and sampling written
+  const PolycubeResult* polycube = chosen.polycube.get();
+  const PolycubeMap* map = chosen.map.get();
   const Polycube* written_polycube = nullptr;  // P as written: refined when the map refines its sampling
-  Eigen::MatrixX3d on_model_xyz, on_polycube_xyz;  // the map at the vertices, smoothed when asked
-  if (runs(options.stage, "polycube")) {
-    progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
-    polycube = alignment.polycube ? std::move(*alignment.polycube) : build_polycube(model, topology, options.polycube);
+  Eigen::MatrixX3d on_polycube_xyz;             // the map at the model's vertices, smoothed when asked
+  if (polycube) {
     model_pieces = &polycube->model_sliced;
     report["polycube"] = polycube_json(*polycube);
     seconds["polycube"] = polycube->seconds_total;
-    for (const std::string& repair : polycube->repairs) progress.warning("polycube: " + repair);
-    progress.stage("polycube", std::to_string(polycube->polycube.corners.size()) + " corners, " +
-                                   std::to_string(polycube->polycube.faces.size()) + " faces, " +
-                                   std::to_string(polycube->polycube_sliced.pieces.size()) + " pieces matched");
     written_polycube = &polycube->polycube;
   }
   const std::string polycube_path = (dir / "polycube.obj").string();
-  if (polycube && !runs(options.stage, "map")) {
+  if (polycube && !map) {
     write_mesh(polycube_path, mesh_to_input(polycube->polycube.mesh));
     outputs.push_back(polycube_path);
   }
-  if (runs(options.stage, "map")) {
-    progress.stage("map", "boundary maps, slits, disk maps of " + std::to_string(polycube->piece_match.size()) + " piece pairs");
-    map = alignment.map ? std::move(*alignment.map) : build_polycube_map(model, *polycube);
+  if (map) {
+    const Finished& finished = *chosen.finished;
     seconds["map"] = map->seconds;
     int flipped_disks = 0, ricci_pieces = 0, ricci_iterations = 0, flat_slits = 0, slits = 0;
     double ricci_residual = 0, min_disk_area = INFINITY;
@@ -257,141 +488,15 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       slits += p.slits;
       min_disk_area = std::min(min_disk_area, p.min_disk_area);
     }
-    auto direction_json = [](const MapDirectionAudit& a) {
-      return nlohmann::json{{"triangles", a.triangles}, {"flipped", a.flipped}, {"degenerate", a.degenerate},
-                            {"max_distance", a.max_distance}, {"area_ratio", a.area_ratio}, {"ok", a.ok}};
-    };
-    // P's sampling of φ refined where its chords flip or lose area (issue 5), before the smoothing
-    // (φ itself at the new vertices) and after it (the smoothed chords projected on the model):
-    // P's surface stays the same, its triangulation gets finer, and every later step and file
-    // uses the refined one.
-    auto refinement_json = [](const MapRefinementResult& r) {
-      auto side = [](const MapDirectionAudit& a) {
-        return nlohmann::json{{"flipped", a.flipped}, {"degenerate", a.degenerate}, {"area_ratio", a.area_ratio}};
-      };
-      return nlohmann::json{{"refined", r.refined},       {"converged", r.converged},
-                            {"rounds", r.rounds},         {"bisections", r.bisections},
-                            {"vertices_before", r.vertices_before}, {"vertices_after", r.vertices_after},
-                            {"triangles_before", r.triangles_before}, {"triangles_after", r.triangles_after},
-                            {"before", side(r.before)},   {"after", side(r.after)},
-                            {"model_to_polycube_before", side(r.model_to_polycube_before)},
-                            {"model_to_polycube_after", side(r.model_to_polycube_after)},
-                            {"model_to_polycube_rejected", r.model_to_polycube_rejected},
-                            {"frozen_faces", r.frozen_faces},
-                            {"seconds", r.seconds}};
-    };
-    auto refinement_line = [](const MapRefinementResult& r) {
-      std::ostringstream line;
-      line << r.vertices_before << " -> " << r.vertices_after << " vertices in " << r.rounds << " rounds; P to M flipped "
-           << r.before.flipped + r.before.degenerate << " -> " << r.after.flipped + r.after.degenerate << ", image area "
-           << std::fixed << std::setprecision(4) << r.before.area_ratio << " -> " << r.after.area_ratio;
-      return line.str();
-    };
-    // Stage 5 (§3.5): smoothing that never adds a flip in either direction, then the second
-    // refinement, on a given P and sampling; the audit of the result.
-    auto finish = [&](const Polycube& P, const PolycubeMap& sampled) {
-      auto out = std::make_unique<Finished>();
-      out->polycube = &P;
-      out->on_model_xyz = sampled.polycube_on_model_xyz;
-      out->on_polycube_xyz = sampled.model_on_polycube_xyz;
-      if (options.smooth_sweeps > 0) {
-        progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded");
-        // smooth_map audits its input itself (flipped_before); the distortion before is cheap.
-        const DistortionStats before = map_distortion(P.mesh, out->on_model_xyz);
-        MapSmoothingOptions smooth_options;
-        smooth_options.sweeps = options.smooth_sweeps;
-        const MapSmoothingResult smoothed = smooth_map(model, P, sampled, smooth_options);
-        out->on_model_xyz = smoothed.polycube_on_model_xyz;
-        out->on_polycube_xyz = smoothed.model_on_polycube_xyz;
-        out->smooth_seconds = smoothed.seconds;
-        out->smoothing = {{"sweeps", smoothed.sweeps},
-                          {"rounds", smoothed.rounds},
-                          {"moves", smoothed.moves},
-                          {"rejected", smoothed.rejected},
-                          {"frozen_polycube_vertices", smoothed.frozen},
-                          {"relocated_model_vertices", smoothed.relocated},
-                          {"seconds", smoothed.seconds},
-                          {"before", {{"polycube_to_model_flipped", smoothed.flipped_before[0]},
-                                      {"model_to_polycube_flipped", smoothed.flipped_before[1]},
-                                      {"eps_angle", before.eps_angle},
-                                      {"eps_area", before.eps_area},
-                                      {"angle_p95", before.angle_p95},
-                                      {"angle_max", before.angle_max}}}};
-        progress.stage("smooth", std::to_string(smoothed.flipped_before[0]) + " / " + std::to_string(smoothed.flipped_before[1]) +
-                                     " flipped before, " + std::to_string(smoothed.flipped_after[0]) + " / " +
-                                     std::to_string(smoothed.flipped_after[1]) + " after");
-        if (options.refine) {
-          progress.stage("refine", "again where the smoothed map's chords flip or lose area");
-          PolycubeMap samples;
-          samples.polycube_on_model = smoothed.polycube_on_model;
-          samples.polycube_on_model_xyz = smoothed.polycube_on_model_xyz;
-          samples.model_on_polycube = smoothed.model_on_polycube;
-          samples.model_on_polycube_xyz = smoothed.model_on_polycube_xyz;
-          // Nothing moves the images after this: refine only where the audit's 2 % is not met
-          // (it then aims at half of that).
-          MapRefinementOptions resample_options;
-          resample_options.area_tolerance = MapAuditOptions().area_tolerance;
-          out->resampling = std::make_unique<MapRefinementResult>(
-              refine_vertex_map_sampling(model, P, polycube->planes_z, samples, resample_options));
-          out->polycube = &out->resampling->polycube;
-          out->on_model_xyz = out->resampling->map.polycube_on_model_xyz;
-          out->on_polycube_xyz = out->resampling->map.model_on_polycube_xyz;
-          out->resample_seconds = out->resampling->seconds;
-          out->resampling_report = refinement_json(*out->resampling);
-          progress.stage("refine", refinement_line(*out->resampling));
-        }
-      }
-      out->audit = audit_map(model, out->polycube->mesh, out->on_model_xyz, out->on_polycube_xyz);
-      return out;
-    };
-
-    std::unique_ptr<Finished> result;
-    nlohmann::json refinement_report = nullptr;
-    if (options.refine) {
-      progress.stage("refine", "bisecting P's triangles where the map sampled at its vertices flips or loses area");
-      refinement = refine_map_sampling(model, *polycube, *map);
-      progress.stage("refine", refinement_line(*refinement));
-      refinement_report = {{"map", refinement_json(*refinement)}};
-      double refine_seconds = refinement->seconds;
-      std::unique_ptr<Finished> refined = finish(refinement->polycube, refinement->map);
-      refine_seconds += refined->resample_seconds;
-      refinement_report["smoothed"] = refined->resampling_report;
-      if (refinement->refined) {
-        // The smoothing of a refined sampling can end worse than that of the unrefined one (it
-        // is a different problem): the refined result is kept only if neither direction has
-        // more bad triangles, or both together have fewer, than the unrefined P's result.
-        progress.stage("refine", "comparing with the unrefined P's smoothed map");
-        std::unique_ptr<Finished> unrefined = finish(polycube->polycube, *map);
-        refine_seconds += unrefined->resample_seconds;
-        const bool keep = (refined->bad_p() <= unrefined->bad_p() && refined->bad_m() <= unrefined->bad_m()) ||
-                          refined->bad_p() + refined->bad_m() < unrefined->bad_p() + unrefined->bad_m();
-        refinement_report["kept"] = keep;
-        refinement_report["unrefined"] = {{"polycube_to_model", direction_json(unrefined->audit.polycube_to_model)},
-                                          {"model_to_polycube", direction_json(unrefined->audit.model_to_polycube)},
-                                          {"smoothed", unrefined->resampling_report}};
-        seconds["smooth_unrefined"] = unrefined->smooth_seconds;
-        progress.stage("refine", std::string(keep ? "kept" : "dropped") + " (refined P " + std::to_string(refined->bad_p()) + " / " +
-                                     std::to_string(refined->bad_m()) + " flipped, unrefined P " + std::to_string(unrefined->bad_p()) +
-                                     " / " + std::to_string(unrefined->bad_m()) + ")");
-        result = keep ? std::move(refined) : std::move(unrefined);
-      } else {
-        refinement_report["kept"] = false;
-        result = std::move(refined);
-      }
-      seconds["refine"] = refine_seconds;
-    } else {
-      result = finish(polycube->polycube, *map);
-    }
-    if (options.smooth_sweeps > 0) seconds["smooth"] = result->smooth_seconds;
-    written_polycube = result->polycube;
-    finished = std::move(result);
+    if (options.refine) seconds["refine"] = chosen.refine_seconds;
+    if (chosen.smooth_unrefined_seconds > 0) seconds["smooth_unrefined"] = chosen.smooth_unrefined_seconds;
+    if (options.smooth_sweeps > 0) seconds["smooth"] = finished.smooth_seconds;
+    written_polycube = finished.polycube;
     const Polycube& P = *written_polycube;
-    on_model_xyz = finished->on_model_xyz;
-    on_polycube_xyz = finished->on_polycube_xyz;
-    const nlohmann::json& smoothing = finished->smoothing;
+    on_polycube_xyz = finished.on_polycube_xyz;
     write_mesh(polycube_path, mesh_to_input(P.mesh));
     outputs.push_back(polycube_path);
-    const MapAudit& audit = finished->audit;
+    const MapAudit& audit = finished.audit;
     report["map"] = {{"contours", map->contours},
                      {"pieces", map->pieces.size()},
                      {"slits", slits},
@@ -408,10 +513,10 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"angle_max", audit.distortion.angle_max},
                      {"area_p95", audit.distortion.area_p95},
                      {"area_max", audit.distortion.area_max},
-                     {"refinement", refinement_report},
-                     {"smoothing", smoothing}};
+                     {"refinement", chosen.refinement_report},
+                     {"smoothing", finished.smoothing}};
     TriMesh on_model = P.mesh;
-    on_model.V = to_input(on_model_xyz);
+    on_model.V = to_input(finished.on_model_xyz);
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
     write_mesh(on_model_path, on_model);
     outputs.push_back(on_model_path);

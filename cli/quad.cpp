@@ -23,6 +23,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <vector>
 
 namespace polycube::cli {
 
@@ -140,6 +142,23 @@ nlohmann::json quality_json(const QuadQuality& q) {
           {"diagonal", q.diagonal}};
 }
 
+// One orientation's map stages and its quads (those the orientation search built come with it).
+// The quads compare by flipped + degenerate quads, then whether they stay within the warning's
+// Hausdorff distance, then that distance.
+struct QuadAttempt {
+  int candidate = -1;  // in Alignment::candidates; -1: --align none or --map
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  TriMesh aligned;  // the model turned by rotation
+  std::shared_ptr<TopologyResult> topology;
+  std::shared_ptr<PolycubeResult> polycube;
+  std::shared_ptr<PolycubeMap> map;
+  std::optional<QuadRemeshResult> result;
+  double smooth_map_seconds = 0, seconds = 0;
+  int bad() const { return result->quality.flipped_quads + result->quality.degenerate_quads; }
+  bool too_far() const { return result->quality.hausdorff_measured && result->quality.hausdorff_percent > kHausdorffWarnPercent; }
+  std::tuple<int, int, double> rank() const { return {bad(), too_far() ? 1 : 0, result->quality.hausdorff_percent}; }
+};
+
 int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   const Progress progress(global);
   // Fail before the long stages when the outputs cannot go where asked.
@@ -162,27 +181,34 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                           {"map", options.map_dir.empty() ? nlohmann::json() : nlohmann::json(options.map_dir)}};
   nlohmann::json seconds = {{"read", progress.elapsed_seconds()}};
 
-  // The map P → M: from the directory, or built now.
-  const TriMesh* polycube_mesh = nullptr;
-  SurfaceMap to_model;
+  // The map P → M: from the directory, or built now (one orientation at a time: the search's
+  // winner, then, while the quads fall short, its next candidates; see below).
   std::optional<MapFromDirectory> from_directory;
-  std::optional<PolycubeResult> polycube;
-  std::optional<PolycubeMap> map;
-  TriMesh aligned;
+  Alignment alignment;
   QuadRemeshOptions remesh;
+  remesh.grid.cell_size = options.cell_size;
+  remesh.grid.target_quads = options.target_faces;
+  remesh.smooth.sweeps = options.smooth;
+  remesh.refine.rounds = options.refine;
+  remesh.refine.target_percent = options.refine_target;
+  remesh.refine.max_growth = options.refine_growth;
+  remesh.carry.threads = 0;  // both maps only read; interpolation and closest points are thread-safe
+  remesh.refine.threads = remesh.carry.threads;
+  if (!options.fit) remesh.fit.passes = 0;
+  const auto report_stage = [&progress](const std::string& stage, const std::string& message) { progress.stage(stage, message); };
+  std::vector<std::unique_ptr<QuadAttempt>> attempts;
   if (!options.map_dir.empty()) {
     progress.stage("map", "reading " + options.map_dir);
     from_directory = read_map_directory(options.map_dir, projector, progress);
-    polycube_mesh = &from_directory->polycube;
-    to_model = from_directory->to_model;
-    remesh.carry.threads = 0;  // interpolation and closest points are thread-safe
+    auto a = std::make_unique<QuadAttempt>();
+    a->result = remesh_quads(from_directory->polycube, from_directory->to_model, *projector, remesh, report_stage);
+    attempts.push_back(std::move(a));
   } else {
     report["parameters"]["dz"] = options.topology.dz;
     report["parameters"]["da"] = options.polycube.da;
     // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
     // images are turned back into the input's frame.
-    Alignment alignment;
-    Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+    auto first = std::make_unique<QuadAttempt>();
     if (options.align == "auto" || options.align == "corners") {
       AlignmentOptions align_options;
       if (options.align == "corners") align_options.mapped_candidates = 0;
@@ -196,52 +222,97 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
         progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
       if (alignment.chosen < 0)
         throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
-      rotation = alignment.rotation;
       progress.stage("align", alignment.candidates[alignment.chosen].name);
+      first->candidate = alignment.chosen;
+      first->rotation = alignment.rotation;
+      first->topology = alignment.topology;
+      first->polycube = alignment.polycube;
+      first->map = alignment.map;
     }
     report["parameters"]["align"] = options.align;
-    aligned = rotated(model, rotation);
+    attempts.push_back(std::move(first));
+    for (const AlignedStages& s : alignment.alternatives) {
+      auto a = std::make_unique<QuadAttempt>();
+      a->candidate = s.candidate;
+      a->rotation = alignment.candidates[s.candidate].rotation;
+      a->topology = s.topology;
+      a->polycube = s.polycube;
+      a->map = s.map;
+      attempts.push_back(std::move(a));
+    }
+  }
+  // The map stages one orientation still needs, then its quads.
+  const auto remesh_with = [&](QuadAttempt& a) {
+    const double start = progress.elapsed_seconds();
+    a.aligned = rotated(model, a.rotation);
     progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
-    const TopologyResult topology = alignment.topology ? std::move(*alignment.topology) : analyse_topology(aligned, options.topology);
-    seconds["topology"] = topology.seconds_total;
+    if (!a.topology) a.topology = std::make_shared<TopologyResult>(analyse_topology(a.aligned, options.topology));
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
-    polycube = alignment.polycube ? std::move(*alignment.polycube) : build_polycube(aligned, topology, options.polycube);
-    for (const std::string& repair : polycube->repairs) progress.warning("polycube: " + repair);
-    seconds["polycube"] = polycube->seconds_total;
-    progress.stage("polycube", std::to_string(polycube->polycube.corners.size()) + " corners, " +
-                                   std::to_string(polycube->polycube.faces.size()) + " faces");
+    if (!a.polycube) a.polycube = std::make_shared<PolycubeResult>(build_polycube(a.aligned, *a.topology, options.polycube));
+    for (const std::string& repair : a.polycube->repairs) progress.warning("polycube: " + repair);
+    progress.stage("polycube", std::to_string(a.polycube->polycube.corners.size()) + " corners, " +
+                                   std::to_string(a.polycube->polycube.faces.size()) + " faces");
     progress.stage("map", "bijection between the polycube and the model");
-    map = alignment.map ? std::move(*alignment.map) : build_polycube_map(aligned, *polycube);
-    seconds["map"] = map->seconds;
-    polycube_mesh = &polycube->polycube.mesh;
+    if (!a.map) a.map = std::make_shared<PolycubeMap>(build_polycube_map(a.aligned, *a.polycube));
+    const TriMesh& P = a.polycube->polycube.mesh;
+    SurfaceMap to_model;
     if (options.smooth_map_sweeps > 0) {
       // The smoothed map (as `map` writes it): its images at P's vertices, interpolated in P's
       // triangles and placed on the model.
       progress.stage("smooth", "harmonic relaxation of the map, flips guarded");
       MapSmoothingOptions smooth_options;
       smooth_options.sweeps = options.smooth_map_sweeps;
-      const MapSmoothingResult smoothed = smooth_map(aligned, polycube->polycube, *map, smooth_options);
-      seconds["smooth_map"] = smoothed.seconds;
-      to_model = projected_map(vertex_image_map(*polycube_mesh, smoothed.polycube_on_model_xyz * rotation), projector);
+      const MapSmoothingResult smoothed = smooth_map(a.aligned, a.polycube->polycube, *a.map, smooth_options);
+      a.smooth_map_seconds = smoothed.seconds;
+      to_model = projected_map(vertex_image_map(P, smoothed.polycube_on_model_xyz * a.rotation), projector);
     } else {
+      const TriMesh& aligned = a.aligned;
+      const PolycubeMap& map = *a.map;
+      const Eigen::Matrix3d rotation = a.rotation;
       to_model = [&aligned, &map, rotation](const SurfacePoint& p) -> Eigen::Vector3d {
-        return rotation.transpose() * surface_position(aligned, map->to_model(p));
+        return rotation.transpose() * surface_position(aligned, map.to_model(p));
       };
     }
-    remesh.carry.threads = 0;  // both maps only read
+    a.result = remesh_quads(P, to_model, *projector, remesh, report_stage);
+    a.seconds = progress.elapsed_seconds() - start;
+  };
+  QuadAttempt* kept = nullptr;
+  for (std::unique_ptr<QuadAttempt>& attempt : attempts) {
+    QuadAttempt& a = *attempt;
+    if (kept)
+      progress.stage("retry", "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
+                                  percent(kept->result->quality.hausdorff_percent) +
+                                  " % Hausdorff); the next orientation candidate, " + alignment.candidates[a.candidate].name);
+    if (!a.result) remesh_with(a);
+    if (!kept || a.rank() < kept->rank()) kept = &a;
+    if (kept->bad() == 0 && !kept->too_far()) break;
   }
-
-  remesh.grid.cell_size = options.cell_size;
-  remesh.grid.target_quads = options.target_faces;
-  remesh.smooth.sweeps = options.smooth;
-  remesh.refine.rounds = options.refine;
-  remesh.refine.target_percent = options.refine_target;
-  remesh.refine.max_growth = options.refine_growth;
-  remesh.refine.threads = remesh.carry.threads;
-  if (!options.fit) remesh.fit.passes = 0;
-  const QuadRemeshResult result =
-      remesh_quads(*polycube_mesh, to_model, *projector, remesh,
-                   [&progress](const std::string& stage, const std::string& message) { progress.stage(stage, message); });
+  if (attempts.size() > 1) {
+    double retry_seconds = 0;
+    nlohmann::json tried = nlohmann::json::array();
+    for (const std::unique_ptr<QuadAttempt>& a : attempts) {
+      if (!a->result) continue;
+      if (a.get() != kept) retry_seconds += a->seconds;
+      tried.push_back({{"name", alignment.candidates[a->candidate].name},
+                       {"quads", a->result->quality.quads},
+                       {"flipped", a->result->quality.flipped_quads},
+                       {"degenerate", a->result->quality.degenerate_quads},
+                       {"hausdorff_percent", a->result->quality.hausdorff_percent},
+                       {"kept", a.get() == kept},
+                       {"seconds", a->seconds}});
+    }
+    report["alignment"]["tried"] = tried;
+    seconds["retry"] = retry_seconds;
+    if (kept->candidate != alignment.chosen) progress.stage("retry", "kept " + alignment.candidates[kept->candidate].name);
+  }
+  if (kept->candidate >= 0) report["alignment"]["chosen"] = alignment.candidates[kept->candidate].name;
+  if (kept->topology) {
+    seconds["topology"] = kept->topology->seconds_total;
+    seconds["polycube"] = kept->polycube->seconds_total;
+    seconds["map"] = kept->map->seconds;
+    if (options.smooth_map_sweeps > 0) seconds["smooth_map"] = kept->smooth_map_seconds;
+  }
+  const QuadRemeshResult& result = *kept->result;
   const QuadQuality& q = result.quality;
   // Everything the result falls short in, on stderr and in the report.
   nlohmann::json warnings = nlohmann::json::array();

@@ -249,6 +249,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     score(first);
   }
   int n = static_cast<int>(out.candidates.size());
+  int first_finer = n;  // candidates from here on are finer-P variants
   // The few with the fewest corners get their map built and audited (vertex-sampled flips both
   // ways, ε_angle): corners alone do not tell a good map from a bad one.
   std::vector<int> mapped;
@@ -291,6 +292,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     PolycubeOptions finer = scoring;
     finer.min_vertices = std::max(polycube.min_vertices, options.fine_polycube_vertices);
     std::vector<int> variants;
+    first_finer = n;
     for (int i = 0; i < n; ++i) {
       if (!maps[i]) continue;
       AlignmentCandidate c = out.candidates[i];
@@ -397,6 +399,18 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     out.topology = topologies[out.chosen];
     out.polycube = polycubes[out.chosen];
     out.map = maps[out.chosen];
+    // The next best mapped candidates, the best of the winner's other P density first.
+    std::vector<int> others;
+    for (int i = 0; i < n; ++i)
+      if (i != out.chosen && maps[i] && polycubes[i]) others.push_back(i);
+    std::stable_sort(others.begin(), others.end(), [&](int a, int b) { return key(a) < key(b); });
+    const bool chosen_finer = out.chosen >= first_finer;
+    const auto twin = std::find_if(others.begin(), others.end(), [&](int i) { return (i >= first_finer) != chosen_finer; });
+    if (twin != others.end()) std::rotate(others.begin(), twin, twin + 1);
+    for (int i : others) {
+      if (static_cast<int>(out.alternatives.size()) >= options.alternatives) break;
+      out.alternatives.push_back({i, topologies[i], polycubes[i], maps[i]});
+    }
   }
   if (out.chosen >= 0) out.rotation = out.candidates[out.chosen].rotation;
   return out;

@@ -46,6 +46,15 @@ struct AlignmentCandidate {
 //   topology, polycube, map  the winner's stages (built on the turned model), so they need not be
 //              redone (map is null when the winner was not mapped, or was scored on the proxy)
 //   proxy_faces  faces of the simplified copy the candidates were scored on (0: the model itself)
+//   alternatives  other mapped candidates with their stages, next best first (see
+//              AlignmentOptions::alternatives), for a caller whose later stages (refinement,
+//              smoothing) may end with flips on the winner and who then tries the next
+struct AlignedStages {
+  int candidate = -1;
+  std::shared_ptr<TopologyResult> topology;
+  std::shared_ptr<PolycubeResult> polycube;
+  std::shared_ptr<PolycubeMap> map;
+};
 struct Alignment {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   int chosen = -1;
@@ -54,6 +63,7 @@ struct Alignment {
   std::shared_ptr<PolycubeResult> polycube;
   std::shared_ptr<PolycubeMap> map;
   int proxy_faces = 0;
+  std::vector<AlignedStages> alternatives;
 };
 
 // Principal axes of the surface (area-weighted covariance of the triangles), as the rows of a
@@ -106,6 +116,12 @@ struct AlignmentOptions {
   // map with the fewest flips still wins. 0: never.
   int coarse_below = 5000;
   int fine_polycube_vertices = 20000;
+  // How many other mapped candidates come back in Alignment::alternatives: first the best of the
+  // other P density (the winner's twin kind: finer P when the winner is not, and the other way
+  // round), then the next best by the score. The unsmoothed flips the score counts are a weak
+  // proxy for the finished map's (a winner by 28 to 32 flips ended 1 / 1, the runner-up 0 / 1).
+  // Never on the proxy (the alternatives would be stages of the copy).
+  int alternatives = 2;
 };
 
 // Scores the candidates (input frame / principal axes / normal axes × which axis is z); see the

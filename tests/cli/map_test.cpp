@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 
 namespace polycube {
 namespace {
@@ -116,6 +117,59 @@ TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
   EXPECT_EQ(report.at("map").at("flipped_disk_triangles").get<int>(), 0);
   EXPECT_LT(report.at("map").at("polycube_to_model").at("max_distance").get<double>(), 1e-9);
   EXPECT_LT(report.at("map").at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
+}
+
+// When the winner's finished map (refined, smoothed) still has flips or P's image misses 2 % of the area,
+// the search's next candidates are finished too and the best finished map is written: torus_quad
+// (25 vertices) ends its winner with 97 % of the area. The kept one ranks first by flips, then
+// whether it meets that contract, then ε_angle; the files and the report are its, in its frame.
+TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
+  const std::string dir = test::temp_dir("map-retry");
+  const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("torus_quad.off")) + " -o " + quoted(dir));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  ASSERT_TRUE(report.at("alignment").contains("finished")) << "the winner's finished map met the contract: pick another mesh";
+  const auto& finished = report.at("alignment").at("finished");
+  ASSERT_GE(finished.size(), 2u);
+  EXPECT_FALSE(finished.at(0).at("meets_contract").get<bool>());
+  int kept = -1;
+  auto rank = [&](const nlohmann::json& f) {
+    return std::make_tuple(f.at("polycube_to_model_flipped").get<int>() + f.at("model_to_polycube_flipped").get<int>(),
+                           f.at("meets_contract").get<bool>() ? 0 : 1, f.at("eps_angle").get<double>());
+  };
+  for (size_t i = 0; i < finished.size(); ++i) {
+    if (i + 1 < finished.size()) {
+      EXPECT_FALSE(finished.at(i).at("meets_contract").get<bool>()) << "finishing stops at a map that meets it";
+    }
+    if (!finished.at(i).at("kept").get<bool>()) continue;
+    EXPECT_EQ(kept, -1) << "one kept";
+    kept = static_cast<int>(i);
+  }
+  ASSERT_GE(kept, 0);
+  for (const auto& f : finished) EXPECT_LE(rank(finished.at(kept)), rank(f));
+  const auto& k = finished.at(kept);
+  EXPECT_EQ(report.at("alignment").at("chosen").get<std::string>(), k.at("name").get<std::string>());
+  const auto& map = report.at("map");
+  EXPECT_EQ(map.at("polycube_to_model").at("flipped").get<int>() + map.at("polycube_to_model").at("degenerate").get<int>(),
+            k.at("polycube_to_model_flipped").get<int>());
+  EXPECT_EQ(map.at("model_to_polycube").at("flipped").get<int>() + map.at("model_to_polycube").at("degenerate").get<int>(),
+            k.at("model_to_polycube_flipped").get<int>());
+  EXPECT_DOUBLE_EQ(map.at("eps_angle").get<double>(), k.at("eps_angle").get<double>());
+  EXPECT_GT(report.at("seconds").at("retry").get<double>(), 0.0);
+  // The written P is axis-aligned in the kept candidate's frame (the report's rotation), and
+  // the model's images lie on it.
+  Eigen::Matrix3d R;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = report.at("alignment").at("rotation").at(i).at(j).get<double>();
+  const PreparedMesh p = prepare_mesh(read_polygon_soup(dir + "/polycube.obj"));
+  TriMesh turned = p.mesh;
+  turned.V = p.mesh.V * R.transpose();
+  const Eigen::MatrixX3d normals = face_normals(turned);
+  int tilted = 0;
+  for (int f = 0; f < turned.num_faces(); ++f) tilted += normals.row(f).cwiseAbs().maxCoeff() < 1 - 1e-9;
+  EXPECT_EQ(tilted, 0);
+  EXPECT_LT(map.at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
+  EXPECT_EQ(read_polygon_soup(dir + "/model_on_polycube.obj").points.size(), read_polygon_soup(test::data_path("torus_quad.off")).points.size());
 }
 
 TEST(MapCli, QuietRunPrintsNothing) {

@@ -205,6 +205,27 @@ TEST(Align, ChoosesTheMappedCandidateWithFewestFlips) {
   if (w.name.find(", finer P") != std::string::npos) {
     EXPECT_GT(a.polycube->polycube.mesh.num_vertices(), 2 * model.num_vertices()) << "about 20 000 asked";
   }
+  // The alternatives: two other mapped candidates with their own stages, the first of the
+  // winner's other P density, the second the best of the rest by the score.
+  auto finer_name = [](const AlignmentCandidate& c) { return c.name.find(", finer P") != std::string::npos; };
+  ASSERT_EQ(a.alternatives.size(), 2u);
+  EXPECT_NE(finer_name(a.candidates[a.alternatives[0].candidate]), finer_name(w));
+  for (const AlignedStages& s : a.alternatives) {
+    ASSERT_GE(s.candidate, 0);
+    EXPECT_NE(s.candidate, a.chosen);
+    const AlignmentCandidate& c = a.candidates[s.candidate];
+    EXPECT_GE(c.flipped, 0) << c.name << " was mapped";
+    ASSERT_TRUE(s.topology && s.polycube && s.map) << c.name;
+    EXPECT_EQ(static_cast<int>(s.polycube->polycube.corners.size()), c.corners);
+    EXPECT_EQ(s.map->polycube_on_model_xyz.rows(), s.polycube->polycube.mesh.num_vertices());
+  }
+  EXPECT_NE(a.alternatives[0].candidate, a.alternatives[1].candidate);
+  const AlignmentCandidate& second = a.candidates[a.alternatives[1].candidate];
+  for (size_t i = 0; i < a.candidates.size(); ++i) {
+    const AlignmentCandidate& c = a.candidates[i];
+    if (c.flipped < 0 || static_cast<int>(i) == a.chosen || static_cast<int>(i) == a.alternatives[0].candidate) continue;
+    EXPECT_TRUE(c.flipped > second.flipped || (c.flipped == second.flipped && c.eps_angle >= second.eps_angle)) << c.name;
+  }
   // Without the finer variants: only the six orientations.
   AlignmentOptions plain;
   plain.fine_polycube_vertices = 0;
