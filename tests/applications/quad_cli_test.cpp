@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <tuple>
 
 namespace polycube {
 namespace {
@@ -85,6 +86,55 @@ TEST(QuadCli, MapBuiltInMemory) {
   const QuadTopology t = quad_topology(quads);
   EXPECT_TRUE(t.closed_manifold());
   EXPECT_EQ(t.genus(), 2);
+}
+
+// Quads that fall short (a flipped quad, or more than 1 % of the diagonal from the model) try the
+// orientation search's next candidates, and the best are written: elephant at 3000 quads, whose
+// winner's quads have a flipped one. The kept try ranks first (flipped + degenerate, then within
+// 0.5 %, then the distance); the file and the report are its.
+TEST(QuadCli, QuadsThatFallShortTryTheNextOrientations) {
+  const std::string dir = test::temp_dir("quad-retry");
+  const std::string out = dir + "/elephant.obj", report_path = dir + "/report.json";
+  const test::CliRun run = polycube_cli("quad " + quoted(test::data_path("elephant.off")) + " -o " + quoted(out) +
+                                        " --target-faces 3000 --report " + quoted(report_path) + " --quiet");
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
+  ASSERT_TRUE(report["alignment"].contains("tried")) << "the winner's quads were clean: pick another mesh or size";
+  const nlohmann::json& tried = report["alignment"]["tried"];
+  ASSERT_GE(tried.size(), 2u);
+  auto short_of = [](const nlohmann::json& t) {
+    return t["flipped"].get<int>() + t["degenerate"].get<int>() > 0 || t["hausdorff_percent"].get<double>() > 1.0;
+  };
+  auto rank = [](const nlohmann::json& t) {
+    return std::make_tuple(t["flipped"].get<int>() + t["degenerate"].get<int>(), t["hausdorff_percent"].get<double>() > 0.5 ? 1 : 0,
+                           t["hausdorff_percent"].get<double>());
+  };
+  int kept = -1;
+  for (size_t i = 0; i < tried.size(); ++i) {
+    if (i + 1 < tried.size()) {
+      // A later one is tried only while the best so far falls short.
+      auto best = tried[0];
+      for (size_t j = 1; j <= i; ++j)
+        if (rank(tried[j]) < rank(best)) best = tried[j];
+      EXPECT_TRUE(short_of(best)) << i;
+    }
+    if (tried[i]["kept"].get<bool>()) {
+      EXPECT_EQ(kept, -1) << "one kept";
+      kept = static_cast<int>(i);
+    }
+  }
+  ASSERT_GE(kept, 0);
+  for (const nlohmann::json& t : tried) EXPECT_LE(rank(tried[kept]), rank(t));
+  EXPECT_EQ(report["alignment"]["chosen"], tried[kept]["name"]);
+  const QuadMesh quads = read_quads(out);
+  EXPECT_EQ(quads.num_quads(), tried[kept]["quads"].get<int>());
+  EXPECT_EQ(report["quality"]["quads"], tried[kept]["quads"]);
+  EXPECT_EQ(report["quality"]["flipped_quads"], tried[kept]["flipped"]);
+  EXPECT_DOUBLE_EQ(report["quality"]["hausdorff_percent_diagonal"].get<double>(), tried[kept]["hausdorff_percent"].get<double>());
+  const QuadTopology t = quad_topology(quads);
+  EXPECT_TRUE(t.closed_manifold());
+  EXPECT_EQ(t.genus(), 3);
+  EXPECT_GT(report["seconds"]["retry"].get<double>(), 0.0);
 }
 
 TEST(QuadCli, CleanErrors) {
