@@ -132,24 +132,19 @@ struct Finished {
     return bad_p() == 0 && bad_m() == 0 && audit.polycube_to_model.ok &&
            audit.model_to_polycube.max_distance <= MapAuditOptions().surface_tolerance;
   }
+  // Finished maps compare by flipped + degenerate triangles both ways, then whether they meet
+  // the contract, then ε_angle.
+  std::tuple<int, int, double> rank() const { return {bad_p() + bad_m(), meets_contract() ? 0 : 1, audit.distortion.eps_angle}; }
 };
 
-// One orientation's stages, from the topology to the finished map (those the orientation search
-// built come with it). Heap-held: finished points into refinement or polycube.
-struct Attempt {
-  int candidate = -1;  // in Alignment::candidates; -1 with --align none
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+// One orientation's stages (those the orientation search built come with it; candidate -1 with
+// --align none), then its finished map. Heap-held: finished points into refinement or polycube.
+struct Attempt : AlignedStages {
   TriMesh model;  // turned by rotation
-  std::shared_ptr<TopologyResult> topology;
-  std::shared_ptr<PolycubeResult> polycube;
-  std::shared_ptr<PolycubeMap> map;
   std::unique_ptr<MapRefinementResult> refinement;  // P's sampling refined before the smoothing
   std::unique_ptr<Finished> finished;               // after it: the P and sampling written
   nlohmann::json refinement_report = nullptr;
   double refine_seconds = 0, smooth_unrefined_seconds = 0, seconds = 0;
-  // Finished maps compare by flipped + degenerate triangles both ways, then whether they meet
-  // the contract (surface distance and P's image area), then ε_angle.
-  std::tuple<int, int, double> finished_rank;
 };
 
 nlohmann::json polycube_json(const PolycubeResult& result) {
@@ -350,7 +345,6 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   std::vector<std::string> outputs;
 
   // The pipeline runs on the model turned into the chosen frame; outputs go back to the input's.
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Alignment alignment;
   double align_seconds = 0;
   if (options.align == "auto" && options.stage != "topology") {
@@ -367,7 +361,6 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
     align_seconds = progress.elapsed_seconds() - align_start;
     if (alignment.chosen >= 0) {
-      rotation = alignment.rotation;
       const AlignmentCandidate& chosen = alignment.candidates[alignment.chosen];
       report["alignment"]["chosen"] = chosen.name;
       progress.stage("align", chosen.name + " (" + std::to_string(chosen.corners) + " corners)");
@@ -380,23 +373,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   // contract (Finished::meets_contract) tries the search's next candidates
   // (Alignment::alternatives) and keeps the best.
   std::vector<std::unique_ptr<Attempt>> attempts;
-  auto first = std::make_unique<Attempt>();
-  first->candidate = alignment.chosen;
-  first->rotation = rotation;
-  first->topology = alignment.topology;
-  first->polycube = alignment.polycube;
-  first->map = alignment.map;
-  attempts.push_back(std::move(first));
-  if (runs(options.stage, "map"))
-    for (const AlignedStages& a : alignment.alternatives) {
-      auto next = std::make_unique<Attempt>();
-      next->candidate = a.candidate;
-      next->rotation = alignment.candidates[a.candidate].rotation;
-      next->topology = a.topology;
-      next->polycube = a.polycube;
-      next->map = a.map;
-      attempts.push_back(std::move(next));
-    }
+  for (const AlignedStages& stages : alignment.stages_in_order()) {
+    if (!attempts.empty() && !runs(options.stage, "map")) break;  // alternatives compete by their maps
+    attempts.push_back(std::make_unique<Attempt>());
+    static_cast<AlignedStages&>(*attempts.back()) = stages;
+  }
   Attempt* kept = nullptr;
   for (std::unique_ptr<Attempt>& attempt : attempts) {
     Attempt& a = *attempt;
@@ -411,18 +392,17 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       kept = &a;
       break;
     }
-    a.finished_rank = std::make_tuple(a.finished->bad_p() + a.finished->bad_m(), a.finished->meets_contract() ? 0 : 1,
-                                      a.finished->audit.distortion.eps_angle);
-    if (!kept || a.finished_rank < kept->finished_rank) kept = &a;
+    if (!kept || a.finished->rank() < kept->finished->rank()) kept = &a;
     if (kept->finished->meets_contract()) break;
   }
-  Attempt& chosen = *kept;
-  rotation = chosen.rotation;
+  const Attempt& chosen = *kept;
+  const Eigen::Matrix3d rotation = chosen.rotation;
+  const auto finished_attempts = std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->finished != nullptr; });
   if (chosen.candidate >= 0 && chosen.candidate != alignment.chosen) {
     report["alignment"]["chosen"] = alignment.candidates[chosen.candidate].name;
     progress.stage("retry", "kept " + alignment.candidates[chosen.candidate].name);
   }
-  if (attempts.size() > 1) {
+  if (finished_attempts > 1) {
     nlohmann::json finished = nlohmann::json::array();
     for (const std::unique_ptr<Attempt>& a : attempts) {
       if (!a->finished) continue;
@@ -452,7 +432,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   const TopologyResult& topology = *chosen.topology;
   report["topology"] = topology_json(topology);
   nlohmann::json seconds = {{"align", align_seconds}, {"topology", topology.seconds_total}};
-  if (attempts.size() > 1) {
+  if (finished_attempts > 1) {
     double retry_seconds = 0;
     for (const std::unique_ptr<Attempt>& a : attempts)
       if (a.get() != kept) retry_seconds += a->seconds;
@@ -460,7 +440,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   }
   const SlicedMesh* model_pieces = &topology.sliced;
   const PolycubeResult* polycube = chosen.polycube.get();
-  const PolycubeMap* map = chosen.map.get();
+  // The search maps its candidates whatever the stage asked; only a finished map is written.
+  const PolycubeMap* map = chosen.finished ? chosen.map.get() : nullptr;
   const Polycube* written_polycube = nullptr;  // P as written: refined when the map refines its sampling
   Eigen::MatrixX3d on_polycube_xyz;             // the map at the model's vertices, smoothed when asked
   if (polycube) {

@@ -150,13 +150,9 @@ nlohmann::json quality_json(const QuadQuality& q) {
 // One orientation's map stages and its quads (those the orientation search built come with it).
 // The quads compare by flipped + degenerate quads, then whether they stay within the warning's
 // Hausdorff distance, then that distance; the next candidate is tried while worth_retrying.
-struct QuadAttempt {
-  int candidate = -1;  // in Alignment::candidates; -1: --align none or --map
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+// candidate -1: --align none or --map.
+struct QuadAttempt : AlignedStages {
   TriMesh aligned;  // the model turned by rotation
-  std::shared_ptr<TopologyResult> topology;
-  std::shared_ptr<PolycubeResult> polycube;
-  std::shared_ptr<PolycubeMap> map;
   std::optional<QuadRemeshResult> result;
   double smooth_map_seconds = 0, seconds = 0;
   int bad() const { return result->quality.flipped_quads + result->quality.degenerate_quads; }
@@ -216,7 +212,6 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     report["parameters"]["da"] = options.polycube.da;
     // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
     // images are turned back into the input's frame.
-    auto first = std::make_unique<QuadAttempt>();
     if (options.align == "auto" || options.align == "corners") {
       AlignmentOptions align_options;
       if (options.align == "corners") align_options.mapped_candidates = 0;
@@ -231,22 +226,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       if (alignment.chosen < 0)
         throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
       progress.stage("align", alignment.candidates[alignment.chosen].name);
-      first->candidate = alignment.chosen;
-      first->rotation = alignment.rotation;
-      first->topology = alignment.topology;
-      first->polycube = alignment.polycube;
-      first->map = alignment.map;
     }
     report["parameters"]["align"] = options.align;
-    attempts.push_back(std::move(first));
-    for (const AlignedStages& s : alignment.alternatives) {
-      auto a = std::make_unique<QuadAttempt>();
-      a->candidate = s.candidate;
-      a->rotation = alignment.candidates[s.candidate].rotation;
-      a->topology = s.topology;
-      a->polycube = s.polycube;
-      a->map = s.map;
-      attempts.push_back(std::move(a));
+    for (const AlignedStages& stages : alignment.stages_in_order()) {
+      attempts.push_back(std::make_unique<QuadAttempt>());
+      static_cast<AlignedStages&>(*attempts.back()) = stages;
     }
   }
   // The map stages one orientation still needs, then its quads.
@@ -295,7 +279,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     if (!kept || a.rank() < kept->rank()) kept = &a;
     if (!kept->worth_retrying()) break;
   }
-  if (attempts.size() > 1) {
+  if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;
     nlohmann::json tried = nlohmann::json::array();
     for (const std::unique_ptr<QuadAttempt>& a : attempts) {

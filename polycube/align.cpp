@@ -162,6 +162,14 @@ TriMesh rotated(const TriMesh& mesh, const Eigen::Matrix3d& rotation) {
   return out;
 }
 
+std::vector<AlignedStages> Alignment::stages_in_order() const {
+  std::vector<AlignedStages> out;
+  if (chosen < 0) return {AlignedStages{}};
+  out.push_back({chosen, rotation, topology, polycube, map});
+  out.insert(out.end(), alternatives.begin(), alternatives.end());
+  return out;
+}
+
 Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology, const PolycubeOptions& polycube,
                            const AlignmentOptions& options) {
   Alignment out;
@@ -217,6 +225,22 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   std::vector<std::shared_ptr<TopologyResult>> topologies;
   std::vector<std::shared_ptr<PolycubeResult>> polycubes;
   std::vector<TriMesh> turned;
+  // Candidate i's stages that are missing (turned copy, topology), then its polycube under
+  // `budget`; a failure is recorded in the candidate (polycubes[i] null).
+  auto build = [&](int i, const PolycubeOptions& budget) {
+    AlignmentCandidate& c = out.candidates[i];
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      if (turned[i].num_faces() == 0) turned[i] = rotated(scored, c.rotation);
+      if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology, harmonic.get()));
+      polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], budget));
+      c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
+    } catch (const Error& e) {
+      c.error = e.what();
+      polycubes[i].reset();
+    }
+    c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   // Topology and polycube, under the scoring budget, of candidates [first, end).
   auto score = [&](int first) {
     const int end = static_cast<int>(out.candidates.size());
@@ -225,21 +249,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     turned.resize(end);
     std::vector<int> order(end - first);
     std::iota(order.begin(), order.end(), first);
-    parallel_for_each(order, options.threads, "orientation", [&](int i) {
-      AlignmentCandidate& c = out.candidates[i];
-      const auto start = std::chrono::steady_clock::now();
-      try {
-        turned[i] = rotated(scored, c.rotation);
-        topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology, harmonic.get()));
-        polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], scoring));
-        c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
-      } catch (const Error& e) {
-        c.error = e.what();
-        topologies[i].reset();
-        polycubes[i].reset();
-      }
-      c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    });
+    parallel_for_each(order, options.threads, "orientation", [&](int i) { build(i, scoring); });
   };
   score(0);
   auto any_passed = [&]() { return std::any_of(polycubes.begin(), polycubes.end(), [](const auto& p) { return p != nullptr; }); };
@@ -300,6 +310,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       c.flipped = -1;
       c.eps_angle = -1;
       c.eps_area = -1;
+      c.seconds = 0;
       c.error.clear();
       variants.push_back(static_cast<int>(out.candidates.size()));
       out.candidates.push_back(c);
@@ -308,18 +319,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       polycubes.push_back(nullptr);
       maps.push_back(nullptr);
     }
-    parallel_for_each(variants, options.threads, "orientation", [&](int j) {
-      AlignmentCandidate& c = out.candidates[j];
-      const auto start = std::chrono::steady_clock::now();
-      try {
-        polycubes[j] = std::make_shared<PolycubeResult>(build_polycube(turned[j], *topologies[j], finer));
-        c.corners = static_cast<int>(polycubes[j]->polycube.corners.size());
-      } catch (const Error& e) {
-        c.error = e.what();
-        polycubes[j].reset();
-      }
-      c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    });
+    parallel_for_each(variants, options.threads, "orientation", [&](int j) { build(j, finer); });
     std::vector<int> built;
     for (int j : variants)
       if (polycubes[j]) built.push_back(j);
@@ -346,27 +346,17 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     larger.max_inserted_planes = std::min(polycube.max_inserted_planes, 4 * scoring.max_inserted_planes);
     larger.max_plane_cells = std::min(polycube.max_plane_cells, 4 * scoring.max_plane_cells);
     larger.max_repair_level = std::min(polycube.max_repair_level, scoring.max_repair_level + 3);
-    auto build = [&](int i, const PolycubeOptions& budget) {
-      AlignmentCandidate& c = out.candidates[i];
-      const auto start = std::chrono::steady_clock::now();
-      try {
-        if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology, harmonic.get()));
-        polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], budget));
-        c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
-        c.fallback_budget = true;
-      } catch (const Error& e) {
-        c.error = e.what();
-        polycubes[i].reset();
-      }
-      c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    auto build_fallback = [&](int i, const PolycubeOptions& budget) {
+      build(i, budget);
+      if (polycubes[i]) out.candidates[i].fallback_budget = true;
     };
     std::vector<int> all(n);
     std::iota(all.begin(), all.end(), 0);
-    parallel_for_each(all, options.threads, "orientation", [&](int i) { build(i, larger); });
+    parallel_for_each(all, options.threads, "orientation", [&](int i) { build_fallback(i, larger); });
     for (int i = 0; i < n; ++i)
       if (polycubes[i] && (out.chosen < 0 || out.candidates[i].corners < out.candidates[out.chosen].corners)) out.chosen = i;
     for (int i = 0; i < n && out.chosen < 0; ++i) {
-      build(i, polycube);
+      build_fallback(i, polycube);
       if (polycubes[i]) out.chosen = i;
     }
   }
@@ -409,7 +399,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     if (twin != others.end()) std::rotate(others.begin(), twin, twin + 1);
     for (int i : others) {
       if (static_cast<int>(out.alternatives.size()) >= options.alternatives) break;
-      out.alternatives.push_back({i, topologies[i], polycubes[i], maps[i]});
+      out.alternatives.push_back({i, out.candidates[i].rotation, topologies[i], polycubes[i], maps[i]});
     }
   }
   if (out.chosen >= 0) out.rotation = out.candidates[out.chosen].rotation;

@@ -51,6 +51,7 @@ struct AlignmentCandidate {
 //              smoothing) may end with flips on the winner and who then tries the next
 struct AlignedStages {
   int candidate = -1;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   std::shared_ptr<TopologyResult> topology;
   std::shared_ptr<PolycubeResult> polycube;
   std::shared_ptr<PolycubeMap> map;
@@ -64,6 +65,10 @@ struct Alignment {
   std::shared_ptr<PolycubeMap> map;
   int proxy_faces = 0;
   std::vector<AlignedStages> alternatives;
+  // The winner's stages, then the alternatives'. With no winner (nothing chosen, or no search
+  // run): one entry with the identity and nothing built, for the caller to build in the input
+  // frame.
+  std::vector<AlignedStages> stages_in_order() const;
 };
 
 // Principal axes of the surface (area-weighted covariance of the triangles), as the rows of a

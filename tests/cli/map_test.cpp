@@ -25,6 +25,25 @@ nlohmann::json read_json(const std::string& path) {
   return nlohmann::json::parse(in);
 }
 
+// report.json → alignment.rotation (x_aligned = R x_input).
+Eigen::Matrix3d report_rotation(const nlohmann::json& report) {
+  Eigen::Matrix3d R;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) R(i, j) = report.at("alignment").at("rotation").at(i).at(j).get<double>();
+  return R;
+}
+
+// Faces of the polycube file whose normal, turned by R, is not along an axis.
+int tilted_faces(const std::string& polycube_path, const Eigen::Matrix3d& R) {
+  const PreparedMesh p = prepare_mesh(read_polygon_soup(polycube_path));
+  TriMesh turned = p.mesh;
+  turned.V = p.mesh.V * R.transpose();
+  const Eigen::MatrixX3d normals = face_normals(turned);
+  int tilted = 0;
+  for (int f = 0; f < turned.num_faces(); ++f) tilted += normals.row(f).cwiseAbs().maxCoeff() < 1 - 1e-9;
+  return tilted;
+}
+
 TEST(MapCli, TopologyStageWritesReportAndPieces) {
   const std::string dir = test::temp_dir("map") + "/out";  // created by the command
   const CliRun run = polycube_cli("map " + quoted(test::data_path("eight.off")) + " -o " + quoted(dir) +
@@ -76,6 +95,20 @@ TEST(MapCli, PolycubeStageWritesAValidAxisAlignedPolycubeOfTheSameGenus) {
   EXPECT_NO_THROW(read_image(dir + "/preview.png"));
 }
 
+// With --align auto the search maps candidates anyway; the polycube stage still stops there: P in
+// the chosen frame, no map files, no map in the report.
+TEST(MapCli, PolycubeStageWithAutoAlignmentWritesNoMap) {
+  const std::string dir = test::temp_dir("map-polycube-auto");
+  const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("eight.off")) + " -o " + quoted(dir) + " --stage polycube");
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  EXPECT_FALSE(report.contains("map"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/polycube_on_model.obj"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/model_on_polycube.obj"));
+  EXPECT_EQ(report.at("polycube").at("genus").get<int>(), 2);
+  EXPECT_EQ(tilted_faces(dir + "/polycube.obj", report_rotation(report)), 0);
+}
+
 // The whole map with --align auto: the chosen rotation is proper and orthonormal, P (written in
 // the input's frame) is axis-aligned once turned by it, and both image files have the counts of
 // the meshes they come from, their vertices on the other surface.
@@ -84,9 +117,7 @@ TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
   const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("knot.off")) + " -o " + quoted(dir));
   ASSERT_EQ(run.code, 0) << run.err;
   const auto report = read_json(dir + "/report.json");
-  Eigen::Matrix3d R;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) R(i, j) = report.at("alignment").at("rotation").at(i).at(j).get<double>();
+  const Eigen::Matrix3d R = report_rotation(report);
   EXPECT_LT((R * R.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-9);
   EXPECT_NEAR(R.determinant(), 1.0, 1e-9);
   // Input frame and principal axes, three ways up each (the knot's normals align with no frame),
@@ -107,13 +138,7 @@ TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
   EXPECT_EQ(on_model.polygons, cube.polygons);
   EXPECT_EQ(on_cube.points.size(), model.points.size());
   // P turned into the chosen frame is axis-aligned.
-  const PreparedMesh p = prepare_mesh(cube);
-  TriMesh turned = p.mesh;
-  turned.V = p.mesh.V * R.transpose();
-  const Eigen::MatrixX3d normals = face_normals(turned);
-  int tilted = 0;
-  for (int f = 0; f < turned.num_faces(); ++f) tilted += normals.row(f).cwiseAbs().maxCoeff() < 1 - 1e-9;
-  EXPECT_EQ(tilted, 0);
+  EXPECT_EQ(tilted_faces(dir + "/polycube.obj", R), 0);
   EXPECT_EQ(report.at("map").at("flipped_disk_triangles").get<int>(), 0);
   EXPECT_LT(report.at("map").at("polycube_to_model").at("max_distance").get<double>(), 1e-9);
   EXPECT_LT(report.at("map").at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
@@ -158,16 +183,7 @@ TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   EXPECT_GT(report.at("seconds").at("retry").get<double>(), 0.0);
   // The written P is axis-aligned in the kept candidate's frame (the report's rotation), and
   // the model's images lie on it.
-  Eigen::Matrix3d R;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) R(i, j) = report.at("alignment").at("rotation").at(i).at(j).get<double>();
-  const PreparedMesh p = prepare_mesh(read_polygon_soup(dir + "/polycube.obj"));
-  TriMesh turned = p.mesh;
-  turned.V = p.mesh.V * R.transpose();
-  const Eigen::MatrixX3d normals = face_normals(turned);
-  int tilted = 0;
-  for (int f = 0; f < turned.num_faces(); ++f) tilted += normals.row(f).cwiseAbs().maxCoeff() < 1 - 1e-9;
-  EXPECT_EQ(tilted, 0);
+  EXPECT_EQ(tilted_faces(dir + "/polycube.obj", report_rotation(report)), 0);
   EXPECT_LT(map.at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
   EXPECT_EQ(read_polygon_soup(dir + "/model_on_polycube.obj").points.size(), read_polygon_soup(test::data_path("torus_quad.off")).points.size());
 }
