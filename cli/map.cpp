@@ -458,8 +458,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   if (map) {
     const Finished& finished = *chosen.finished;
     seconds["map"] = map->seconds;
-    int flipped_disks = 0, ricci_pieces = 0, ricci_iterations = 0, flat_slits = 0, slits = 0;
-    double ricci_residual = 0, min_disk_area = INFINITY;
+    int flipped_disks = 0, ricci_pieces = 0, ricci_iterations = 0, flat_slits = 0, slits = 0, decrowded = 0, decrowd_iterations = 0;
+    double ricci_residual = 0, min_disk_area = INFINITY, crowding_before = 1, crowding_after = 1;
     for (const PieceMapStats& p : map->pieces) {
       flipped_disks += p.flipped_model_disk + p.flipped_polycube_disk;
       ricci_pieces += p.ricci_iterations > 0;
@@ -468,6 +468,10 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       flat_slits += p.flat_slits;
       slits += p.slits;
       min_disk_area = std::min(min_disk_area, p.min_disk_area);
+      decrowded += p.decrowd_iterations > 0;
+      decrowd_iterations = std::max(decrowd_iterations, p.decrowd_iterations);
+      crowding_before = std::min(crowding_before, p.min_area_ratio_before);
+      crowding_after = std::min(crowding_after, p.min_area_ratio);
     }
     if (options.refine) seconds["refine"] = chosen.refine_seconds;
     if (chosen.smooth_unrefined_seconds > 0) seconds["smooth_unrefined"] = chosen.smooth_unrefined_seconds;
@@ -485,6 +489,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"ricci", {{"pieces", ricci_pieces}, {"max_iterations", ricci_iterations}, {"max_residual", ricci_residual}}},
                      {"flipped_disk_triangles", flipped_disks},
                      {"min_disk_triangle_area", min_disk_area},
+                     {"crowding",
+                      {{"pieces", decrowded}, {"max_iterations", decrowd_iterations}, {"min_area_ratio_before", crowding_before},
+                       {"min_area_ratio", crowding_after}}},
                      {"polycube_to_model", direction_json(audit.polycube_to_model)},
                      {"model_to_polycube", direction_json(audit.model_to_polycube)},
                      {"eps_angle", audit.distortion.eps_angle},

@@ -227,6 +227,80 @@ CutDisk cut_open(const TriMesh& piece, const std::vector<Slit>& slits) {
   return cut;
 }
 
+namespace {
+
+// Counts the flipped faces and the smallest signed area of the embedding.
+void measure(DiskEmbedding& disk) {
+  disk.flipped = 0;
+  disk.min_area = INFINITY;
+  for (int f = 0; f < disk.mesh.num_faces(); ++f) {
+    const double area = uv_area(disk, f);
+    disk.min_area = std::min(disk.min_area, area);
+    if (!(area > 0)) ++disk.flipped;
+  }
+}
+
+// The harmonic map of a disk for given edge weights: Dirichlet on the fixed vertices, the sparse
+// pattern analysed once so that several weightings of the same disk factorise cheaply.
+class DiskSolver {
+ public:
+  explicit DiskSolver(const DiskEmbedding& disk) : index_(disk.uv.rows(), -1) {
+    for (int v = 0; v < static_cast<int>(index_.size()); ++v)
+      if (!disk.fixed[v]) index_[v] = count_++;
+  }
+
+  // Solves with `weights` (per disk.edges, all > 0) into disk.uv, then measures disk.flipped and
+  // disk.min_area.
+  void solve(const std::vector<double>& weights, DiskEmbedding& disk) {
+    if (count_ > 0) {
+      std::vector<Eigen::Triplet<double>> triplets;
+      Eigen::MatrixX2d rhs = Eigen::MatrixX2d::Zero(count_, 2);
+      for (size_t e = 0; e < disk.edges.size(); ++e) {
+        const double w = weights[e];
+        const int a = disk.edges[e].first, b = disk.edges[e].second;
+        const int ia = index_[a], ib = index_[b];
+        if (ia >= 0) triplets.emplace_back(ia, ia, w);
+        if (ib >= 0) triplets.emplace_back(ib, ib, w);
+        if (ia >= 0 && ib >= 0) {
+          triplets.emplace_back(ia, ib, -w);
+          triplets.emplace_back(ib, ia, -w);
+        } else if (ia >= 0) {
+          rhs.row(ia) += w * disk.uv.row(b);
+        } else if (ib >= 0) {
+          rhs.row(ib) += w * disk.uv.row(a);
+        }
+      }
+      Eigen::SparseMatrix<double> L(count_, count_);
+      L.setFromTriplets(triplets.begin(), triplets.end());
+      if (!analysed_) {
+        solver_.analyzePattern(L);
+        analysed_ = true;
+      }
+      solver_.factorize(L);
+      if (solver_.info() != Eigen::Success) throw AlgorithmError("disk map: the Laplacian of a cut piece could not be factorised");
+      Eigen::MatrixX2d x = solver_.solve(rhs);
+      // Two refinement steps against rounding in badly scaled weights.
+      for (int it = 0; it < 2; ++it) x += solver_.solve(rhs - L * x);
+      for (size_t v = 0; v < index_.size(); ++v)
+        if (index_[v] >= 0) disk.uv.row(v) = x.row(index_[v]);
+    }
+    measure(disk);
+  }
+
+ private:
+  std::vector<int> index_;
+  int count_ = 0;
+  bool analysed_ = false;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver_;
+};
+
+}  // namespace
+
+double uv_area(const DiskEmbedding& disk, int f) {
+  const Eigen::Vector2d a = disk.uv.row(disk.mesh.F(f, 0)), b = disk.uv.row(disk.mesh.F(f, 1)), c = disk.uv.row(disk.mesh.F(f, 2));
+  return 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+}
+
 DiskEmbedding embed_disk(const CutDisk& cut, const std::vector<double>& angle_of,
                          const std::vector<std::vector<std::pair<double, double>>>& extra) {
   const int nb = static_cast<int>(cut.boundary.size());
@@ -294,62 +368,73 @@ DiskEmbedding embed_disk(const CutDisk& cut, const std::vector<double>& angle_of
 
   // Harmonic map with positive weights, Dirichlet on the circle.
   out.uv.resize(n, 2);
-  std::vector<int> interior_index(n, -1);
-  int ni = 0;
+  out.fixed.assign(n, 0);
   for (int v = 0; v < n; ++v) {
-    if (std::isnan(angle[v])) {
-      interior_index[v] = ni++;
-    } else {
-      out.uv(v, 0) = std::cos(angle[v]);
-      out.uv(v, 1) = std::sin(angle[v]);
-    }
+    if (std::isnan(angle[v])) continue;
+    out.fixed[v] = 1;
+    out.uv(v, 0) = std::cos(angle[v]);
+    out.uv(v, 1) = std::sin(angle[v]);
   }
-  if (ni > 0) {
-    std::map<std::pair<int, int>, double> weight;
-    for (const Eigen::Vector3i& t : faces) {
-      for (int i = 0; i < 3; ++i) {
-        const int a = t[(i + 1) % 3], b = t[(i + 2) % 3];
-        const double la = (positions[b] - positions[a]).norm();
-        const double lb = (positions[t[i]] - positions[b]).norm();
-        const double lc = (positions[t[i]] - positions[a]).norm();
-        weight[{std::min(a, b), std::max(a, b)}] += cotan_opposite(la, lb, lc);
-      }
-    }
-    std::vector<Eigen::Triplet<double>> triplets;
-    Eigen::MatrixX2d rhs = Eigen::MatrixX2d::Zero(ni, 2);
-    for (const auto& [edge, raw] : weight) {
-      const double w = std::clamp(std::isfinite(raw) ? raw : 1.0, 1e-3, 1e3);
-      const int a = edge.first, b = edge.second;
-      const int ia = interior_index[a], ib = interior_index[b];
-      if (ia >= 0) triplets.emplace_back(ia, ia, w);
-      if (ib >= 0) triplets.emplace_back(ib, ib, w);
-      if (ia >= 0 && ib >= 0) {
-        triplets.emplace_back(ia, ib, -w);
-        triplets.emplace_back(ib, ia, -w);
-      } else if (ia >= 0) {
-        rhs.row(ia) += w * out.uv.row(b);
-      } else if (ib >= 0) {
-        rhs.row(ib) += w * out.uv.row(a);
-      }
-    }
-    Eigen::SparseMatrix<double> L(ni, ni);
-    L.setFromTriplets(triplets.begin(), triplets.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(L);
-    if (solver.info() != Eigen::Success) throw AlgorithmError("disk map: the Laplacian of a cut piece could not be factorised");
-    Eigen::MatrixX2d x = solver.solve(rhs);
-    // Two refinement steps against rounding in badly scaled weights.
-    for (int it = 0; it < 2; ++it) x += solver.solve(rhs - L * x);
-    for (int v = 0; v < n; ++v)
-      if (interior_index[v] >= 0) out.uv.row(v) = x.row(interior_index[v]);
-  }
-  out.min_area = INFINITY;
+  std::map<std::pair<int, int>, double> weight;
   for (const Eigen::Vector3i& t : faces) {
-    const Eigen::Vector2d a = out.uv.row(t[0]), b = out.uv.row(t[1]), c = out.uv.row(t[2]);
-    const double area = 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
-    out.min_area = std::min(out.min_area, area);
-    if (!(area > 0)) ++out.flipped;
+    for (int i = 0; i < 3; ++i) {
+      const int a = t[(i + 1) % 3], b = t[(i + 2) % 3];
+      const double la = (positions[b] - positions[a]).norm();
+      const double lb = (positions[t[i]] - positions[b]).norm();
+      const double lc = (positions[t[i]] - positions[a]).norm();
+      weight[{std::min(a, b), std::max(a, b)}] += cotan_opposite(la, lb, lc);
+    }
   }
+  for (const auto& [edge, raw] : weight) {
+    if (out.fixed[edge.first] && out.fixed[edge.second]) continue;
+    out.edges.emplace_back(edge.first, edge.second);
+    out.edge_weight.push_back(std::clamp(std::isfinite(raw) ? raw : 1.0, 1e-3, 1e3));
+  }
+  DiskSolver(out).solve(out.edge_weight, out);
   return out;
+}
+
+DecrowdResult decrowd_disk(DiskEmbedding& disk, const AreaRatio& area_ratio, const DecrowdOptions& options) {
+  DecrowdResult result;
+  std::vector<double> ratio = area_ratio(disk);
+  auto smallest = [](const std::vector<double>& r) { return r.empty() ? 1.0 : *std::min_element(r.begin(), r.end()); };
+  result.min_ratio_before = result.min_ratio_after = smallest(ratio);
+  if (!(result.min_ratio_before < options.trigger) || disk.flipped > 0) return result;
+  // Faces of each edge (one or two; the disk is a manifold triangle mesh).
+  std::map<std::pair<int, int>, int> edge_id;
+  for (size_t e = 0; e < disk.edges.size(); ++e) edge_id[disk.edges[e]] = static_cast<int>(e);
+  std::vector<std::vector<int>> edge_faces(disk.edges.size());
+  for (int f = 0; f < disk.mesh.num_faces(); ++f)
+    for (int i = 0; i < 3; ++i) {
+      const int a = disk.mesh.F(f, i), b = disk.mesh.F(f, (i + 1) % 3);
+      const auto it = edge_id.find({std::min(a, b), std::max(a, b)});
+      if (it != edge_id.end()) edge_faces[it->second].push_back(f);
+    }
+  DiskSolver solver(disk);
+  std::vector<double> log_scale(disk.edges.size(), 0.0), weights(disk.edges.size());
+  const double log_target = std::log(options.target);
+  Eigen::MatrixX2d best_uv = disk.uv;
+  for (int it = 1; it <= options.max_iterations; ++it) {
+    for (size_t e = 0; e < disk.edges.size(); ++e) {
+      double step = 0;
+      for (int f : edge_faces[e]) step += std::min(std::log(std::max(ratio[f], 1e-300)) - log_target, 0.0);
+      if (!edge_faces[e].empty()) log_scale[e] += options.step * step / static_cast<double>(edge_faces[e].size());
+      weights[e] = disk.edge_weight[e] * std::exp(log_scale[e]);
+    }
+    solver.solve(weights, disk);
+    if (disk.flipped > 0) break;
+    ratio = area_ratio(disk);
+    result.iterations = it;
+    const double now = smallest(ratio);
+    if (now > result.min_ratio_after) {
+      result.min_ratio_after = now;
+      best_uv = disk.uv;
+    }
+    if (now >= options.stop) break;
+  }
+  disk.uv = best_uv;
+  measure(disk);
+  return result;
 }
 
 }  // namespace polycube

@@ -61,6 +61,8 @@ CutDisk cut_open(const TriMesh& piece, const std::vector<Slit>& slits);
 //   uv            positions in the unit disk: boundary on the unit circle at the angles given,
 //                 inside by the harmonic map
 //   flipped       faces with signed area <= 0 in uv; min_area the smallest signed area
+//   fixed         per vertex: on the unit circle (Dirichlet)
+//   edges, edge_weight  the edges with a free end (a < b) and their harmonic-map weights
 struct DiskEmbedding {
   TriMesh mesh;
   std::vector<int> face_origin;
@@ -68,6 +70,9 @@ struct DiskEmbedding {
   Eigen::MatrixX2d uv;
   int flipped = 0;
   double min_area = 0;
+  std::vector<char> fixed;
+  std::vector<std::pair<int, int>> edges;
+  std::vector<double> edge_weight;
 };
 
 // Inserts the boundary points and embeds.
@@ -80,5 +85,39 @@ struct DiskEmbedding {
 // map is an embedding whatever the mesh), Dirichlet boundary, sparse Cholesky.
 DiskEmbedding embed_disk(const CutDisk& cut, const std::vector<double>& angle_of,
                          const std::vector<std::vector<std::pair<double, double>>>& extra);
+
+// Signed area of face f in the disk.
+double uv_area(const DiskEmbedding& disk, int f);
+
+// Crowding. A harmonic map squeezes a part of the piece behind a narrow neck exponentially in
+// the neck's length over its girth: a blind pocket or a thin finger lying between two cutting
+// planes (femur: a canal of ~100 vertices whose disk triangles have 1e-25 of their share of the
+// area). The other side's disk has no such part, so the map sends it to a point of the other
+// surface (degenerate images), and the other side's triangles never reach it (lost area).
+// decrowd_disk re-solves the disk with the weights of the edges of crowded faces lowered
+// (log weight += step × mean over the edge's faces of min(log(ratio / target), 0)), repeatedly:
+// lower weights let a region spread, the weights stay positive, so every iterate is still an
+// embedding on the same convex boundary (Tutte / Floater), and faces at or above `target` keep
+// their weights (uncrowded parts barely move).
+//   area_ratio  per face of disk.mesh: its image's share of the area over its own share (the
+//               caller's measure of crowding, e.g. through the other side's disk)
+//   trigger     nothing is done unless some face's ratio is below it
+//   stop        iterations end when every ratio is at or above it
+// The iterate with the largest smallest ratio is kept (the input when none is better); an
+// iterate with a flipped face (rounding in extreme weights) ends the iterations.
+struct DecrowdOptions {
+  double trigger = 1e-6;
+  double target = 1e-3;
+  double stop = 1e-5;
+  double step = 1;
+  int max_iterations = 12;
+};
+struct DecrowdResult {
+  int iterations = 0;
+  double min_ratio_before = 1;
+  double min_ratio_after = 1;
+};
+using AreaRatio = std::function<std::vector<double>(const DiskEmbedding&)>;
+DecrowdResult decrowd_disk(DiskEmbedding& disk, const AreaRatio& area_ratio, const DecrowdOptions& options = {});
 
 }  // namespace polycube

@@ -59,6 +59,12 @@ struct PieceMapStats {
   int ricci_iterations = 0;  // Newton iterations of the model piece's flat metric (0: one loop, not needed)
   double ricci_residual = 0; // its max |curvature error|
   bool flat_slits = false;   // slits chosen in the circle domain (false: by 3D length, the metric failed)
+  // Crowding of the model's disk (piece_disk.h, decrowd_disk): the smallest ratio, over its faces,
+  // of the share of P_j's area a face's image covers to its share of M_j's area, before and after
+  // the re-weighting, and the re-weighting's iterations (0: not needed).
+  double min_area_ratio_before = 1;
+  double min_area_ratio = 1;
+  int decrowd_iterations = 0;
   double seconds = 0;
 };
 

@@ -11,9 +11,12 @@
 #include "support/generated_meshes.h"
 #include "support/test_support.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <string>
 #include <vector>
@@ -232,6 +235,99 @@ TEST(PieceDisk, TubeCutAndEmbedded) {
   EXPECT_NEAR(surface_area(split), surface_area(tube), 1e-12);
   EXPECT_EQ(boundary_loops(split.F).size(), 2u);
   EXPECT_EQ(static_cast<int>(parent.size()), split.num_faces());
+}
+
+// A square plate with a blind pocket (a square tube one cell wide and 14 cells deep, closed at the
+// end), as the one disk of a piece: the harmonic map squeezes the pocket to a point (each ring of
+// 4 vertices shrinks it by ~e^-π in area). decrowd_disk spreads it by lowering weights: still no
+// flipped triangle, the boundary where it was, the plate away from the pocket nearly unmoved.
+TEST(PieceDisk, PocketSqueezedByTheHarmonicMapIsSpread) {
+  const int m = 6, side = 2 * m + 2, depth = 14;
+  std::vector<Eigen::Vector3d> V;
+  std::vector<Eigen::Vector3i> F;
+  auto plate = [&](int i, int j) { return j * side + i; };
+  for (int j = 0; j < side; ++j)
+    for (int i = 0; i < side; ++i) V.emplace_back(i - m - 0.5, j - m - 0.5, 0.0);
+  for (int j = 0; j + 1 < side; ++j)
+    for (int i = 0; i + 1 < side; ++i) {
+      if (i == m && j == m) continue;  // the pocket's mouth
+      F.emplace_back(plate(i, j), plate(i + 1, j), plate(i + 1, j + 1));
+      F.emplace_back(plate(i, j), plate(i + 1, j + 1), plate(i, j + 1));
+    }
+  std::vector<int> ring = {plate(m, m), plate(m + 1, m), plate(m + 1, m + 1), plate(m, m + 1)};
+  for (int t = 1; t <= depth; ++t) {
+    std::vector<int> next;
+    for (int k = 0; k < 4; ++k) {
+      next.push_back(static_cast<int>(V.size()));
+      V.push_back(V[ring[k]] - Eigen::Vector3d(0, 0, 1));
+    }
+    for (int k = 0; k < 4; ++k) {
+      const int a = ring[k], b = ring[(k + 1) % 4], c = next[(k + 1) % 4], d = next[k];
+      F.emplace_back(a, b, c);
+      F.emplace_back(a, c, d);
+    }
+    ring = next;
+  }
+  const int end = static_cast<int>(V.size());
+  V.push_back((V[ring[0]] + V[ring[2]]) / 2 - Eigen::Vector3d(0, 0, 0.5));
+  for (int k = 0; k < 4; ++k) F.emplace_back(ring[k], ring[(k + 1) % 4], end);
+  CutDisk cut;
+  cut.mesh.V.resize(V.size(), 3);
+  for (size_t v = 0; v < V.size(); ++v) cut.mesh.V.row(v) = V[v];
+  cut.mesh.F.resize(F.size(), 3);
+  for (size_t f = 0; f < F.size(); ++f) cut.mesh.F.row(f) = F[f];
+  cut.vertex_origin.resize(V.size());
+  std::iota(cut.vertex_origin.begin(), cut.vertex_origin.end(), 0);
+  const std::vector<std::vector<int>> loops = boundary_loops(cut.mesh.F);
+  ASSERT_EQ(loops.size(), 1u);
+  cut.boundary = loops.front();
+  const int nb = static_cast<int>(cut.boundary.size());
+  std::vector<double> angle(nb);
+  for (int k = 0; k < nb; ++k) angle[k] = 2 * M_PI * k / nb;
+  DiskEmbedding disk = embed_disk(cut, angle, std::vector<std::vector<std::pair<double, double>>>(nb));
+  ASSERT_EQ(disk.flipped, 0);
+
+  // Crowding by the disk's own measure: a face's share of the disk over its share of the surface.
+  const double total = surface_area(disk.mesh);
+  const AreaRatio own = [&](const DiskEmbedding& d) {
+    std::vector<double> ratio(d.mesh.num_faces());
+    for (int f = 0; f < d.mesh.num_faces(); ++f) {
+      const Eigen::Vector3d a = d.mesh.V.row(d.mesh.F(f, 0)), b = d.mesh.V.row(d.mesh.F(f, 1)), c = d.mesh.V.row(d.mesh.F(f, 2));
+      ratio[f] = (uv_area(d, f) / M_PI) / (0.5 * (b - a).cross(c - a).norm() / total);
+    }
+    return ratio;
+  };
+  const std::vector<double> before = own(disk);
+  const double worst_before = *std::min_element(before.begin(), before.end());
+  ASSERT_LT(worst_before, 1e-12);  // the pocket's end really is squeezed
+  const Eigen::MatrixX2d uv_before = disk.uv;
+
+  const DecrowdResult result = decrowd_disk(disk, own);
+  EXPECT_GT(result.iterations, 0);
+  EXPECT_DOUBLE_EQ(result.min_ratio_before, worst_before);
+  const std::vector<double> after = own(disk);
+  const double worst_after = *std::min_element(after.begin(), after.end());
+  EXPECT_DOUBLE_EQ(result.min_ratio_after, worst_after);
+  EXPECT_GT(worst_after, 1e4 * worst_before);
+  EXPECT_GT(worst_after, 1e-5);
+  EXPECT_EQ(disk.flipped, 0);
+  for (int f = 0; f < disk.mesh.num_faces(); ++f) EXPECT_GT(uv_area(disk, f), 0) << f;
+  for (int v : cut.boundary) EXPECT_EQ(disk.uv.row(v), uv_before.row(v));
+  // Plate vertices more than two cells from the mouth barely move.
+  double far_moved = 0;
+  for (int j = 0; j < side; ++j)
+    for (int i = 0; i < side; ++i)
+      if (std::max(std::abs(i - m - 0.5), std::abs(j - m - 0.5)) > 2.5)
+        far_moved = std::max(far_moved, (disk.uv.row(plate(i, j)) - uv_before.row(plate(i, j))).norm());
+  EXPECT_LT(far_moved, 0.05);
+
+  // A disk with nothing below the trigger is left as it is.
+  DiskEmbedding plain = embed_disk(cut, angle, std::vector<std::vector<std::pair<double, double>>>(nb));
+  DecrowdOptions never;
+  never.trigger = worst_before / 2;
+  const DecrowdResult untouched = decrowd_disk(plain, own, never);
+  EXPECT_EQ(untouched.iterations, 0);
+  EXPECT_EQ(plain.uv, uv_before);
 }
 
 }  // namespace
