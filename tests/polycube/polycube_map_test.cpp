@@ -309,7 +309,7 @@ TEST(PieceDisk, PocketSqueezedByTheHarmonicMapIsSpread) {
   const double worst_after = *std::min_element(after.begin(), after.end());
   EXPECT_DOUBLE_EQ(result.min_ratio_after, worst_after);
   EXPECT_GT(worst_after, 1e4 * worst_before);
-  EXPECT_GT(worst_after, 1e-5);
+  EXPECT_GT(worst_after, 1e-3);
   EXPECT_EQ(disk.flipped, 0);
   for (int f = 0; f < disk.mesh.num_faces(); ++f) EXPECT_GT(uv_area(disk, f), 0) << f;
   for (int v : cut.boundary) EXPECT_EQ(disk.uv.row(v), uv_before.row(v));
