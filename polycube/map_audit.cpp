@@ -1,5 +1,7 @@
 #include "polycube/map_audit.h"
 
+#include "polycube/image_orientation.h"
+
 #include "polycube/triangle_tree.h"
 
 #include <Eigen/Geometry>
@@ -66,8 +68,8 @@ class TargetSurface {
     return {face, std::sqrt(CGAL::squared_distance(query, point))};
   }
 
-  // Twice the area times the outward unit normal of target face f.
-  const Eigen::Vector3d& area_vector(int f) const { return area_vectors_[f]; }
+  // Per target face: twice the area times the outward unit normal.
+  const std::vector<Eigen::Vector3d>& area_vectors() const { return area_vectors_; }
 
  private:
   std::vector<Eigen::Vector3d> area_vectors_;
@@ -129,13 +131,10 @@ MapDirectionAudit audit_map_direction(const TriMesh& source, const Eigen::Matrix
     // The target's outward normal near the triangle: the distinct faces closest to its centroid
     // and to its corners, area-weighted. Across a polycube edge the corners find both faces, and
     // a correctly oriented chord has a positive dot product with each of them.
-    int faces[4] = {surface.closest((a + b + c) / 3).first, vertex_face[corner[0]], vertex_face[corner[1]],
-                    vertex_face[corner[2]]};
-    std::sort(faces, faces + 4);
-    Eigen::Vector3d nearby = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 4; ++k)
-      if (k == 0 || faces[k] != faces[k - 1]) nearby += surface.area_vector(faces[k]);
-    if (normal.dot(nearby) <= 0) ++audit.flipped;
+    // (image_orientation.h: the faces nearest the centroid and corners, then a finer look.)
+    const auto closest = [&surface](const Eigen::Vector3d& p, int) { return surface.closest(p).first; };
+    if (image_triangle_flipped(a, b, c, vertex_face[corner[0]], vertex_face[corner[1]], vertex_face[corner[2]], surface.area_vectors(), closest))
+      ++audit.flipped;
   }
   audit.area_ratio = image_area / target_area;
   audit.ok = audit.flipped == 0 && audit.degenerate == 0 && audit.max_distance <= options.surface_tolerance &&

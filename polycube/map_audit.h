@@ -29,7 +29,9 @@ struct MapAuditOptions {
 //                 the target's outward normal nearby: the area-weighted sum of the normals of the
 //                 distinct target faces closest to the image triangle's centroid and to its three
 //                 vertices (several faces, so that a chord across a polycube edge, whose normal
-//                 lies between the two face normals, is not called flipped)
+//                 lies between the two face normals, is not called flipped) and, on a second look
+//                 at a triangle that fails the first, of those closest to 15 points spread over it
+//                 (a chord from one face of a thin part to the opposite one; image_orientation.h)
 //   degenerate    image triangles with area <= 1e-14 × target area, or with a non-finite vertex
 //   max_distance  largest distance of an image vertex from the target surface, / target bounding-box
 //                 diagonal (+infinity for a non-finite vertex)

@@ -1,5 +1,6 @@
 #include "polycube/map_refinement.h"
 
+#include "polycube/image_orientation.h"
 #include "polycube/parallel.h"
 #include "polycube/triangle_tree.h"
 
@@ -72,12 +73,8 @@ class AuditTarget {
   int judge(const Vec3& a, const Vec3& b, const Vec3& c, int fa, int fb, int fc) const {
     const Vec3 n = (b - a).cross(c - a);
     if (0.5 * n.norm() <= kDegenerateArea * area_) return 2;
-    int faces[4] = {closest((a + b + c) / 3).first, fa, fb, fc};
-    std::sort(faces, faces + 4);
-    Vec3 nearby = Vec3::Zero();
-    for (int k = 0; k < 4; ++k)
-      if (k == 0 || faces[k] != faces[k - 1]) nearby += area_vectors_[faces[k]];
-    return n.dot(nearby) <= 0 ? 1 : 0;
+    const auto nearest = [this](const Vec3& p, int) { return closest(p).first; };
+    return image_triangle_flipped(a, b, c, fa, fb, fc, area_vectors_, nearest) ? 1 : 0;
   }
 
   // The closest point of the target to p, as a point of a target face.

@@ -1,6 +1,7 @@
 #include "polycube/map_smoothing.h"
 
 #include "polycube/closest_point.h"
+#include "polycube/image_orientation.h"
 
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
@@ -819,7 +820,8 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
 // ---------------------------------------------------------------------------------------------
 // Flipped triangles exactly as the audit (map_audit.cpp) calls them, one flag per triangle: the
 // image triangle degenerate, or its normal against the area-weighted normals of the distinct
-// target faces closest to its centroid and corners.
+// target faces closest to its centroid and corners, and then closest to points spread over it
+// (image_orientation.h).
 using Kernel = CGAL::Simple_cartesian<double>;
 using Point = Kernel::Point_3;
 using Triangle = Kernel::Triangle_3;
@@ -882,12 +884,8 @@ class AuditTarget {
         out[f] = 1;
         return;
       }
-      int faces[4] = {closest((a + b + c) / 3, vertex_face[F(f, 0)]), vertex_face[F(f, 0)], vertex_face[F(f, 1)], vertex_face[F(f, 2)]};
-      std::sort(faces, faces + 4);
-      Vec3 nearby = Vec3::Zero();
-      for (int k = 0; k < 4; ++k)
-        if (k == 0 || faces[k] != faces[k - 1]) nearby += area_vectors_[faces[k]];
-      if (n.dot(nearby) <= 0) out[f] = 1;
+      const auto nearest = [this](const Vec3& p, int seed) { return closest(p, seed); };
+      if (image_triangle_flipped(a, b, c, vertex_face[F(f, 0)], vertex_face[F(f, 1)], vertex_face[F(f, 2)], area_vectors_, nearest)) out[f] = 1;
     });
     return out;
   }

@@ -267,6 +267,23 @@ TEST(MapAudit, ImageTriangleAcrossTheSolidCountsAsFlipped) {
   EXPECT_EQ(audit_map_direction(reversed(standing), standing.V, cube).flipped, 1);
 }
 
+TEST(MapAudit, ChordFromOneFaceOfAThinPartToTheOppositeOneIsJudgedByTheFacesItPassesOver) {
+  // A slab one unit thin in x. The chord has two corners on the cap x = 0 and one on the cap
+  // x = 1, all 0.4 below the top z = 4, and faces up (+z) like the top it runs under. The faces
+  // nearest its corners and centroid are caps with opposite normals (their sum is along x, the
+  // dot product exactly 0); the finer look finds the top face, so it is not flipped. Reversed, it
+  // faces away from the top and from every cap sum: flipped.
+  const TriMesh slab = voxel_polycube(4, [](int i, int, int) { return i < 1; });
+  TriMesh chord;
+  chord.V.resize(3, 3);
+  chord.V << 0, 1, 3.6, 1, 2, 3.6, 0, 3, 3.6;
+  chord.F.resize(1, 3);
+  chord.F << 0, 1, 2;
+  ASSERT_GT(((chord.V.row(1) - chord.V.row(0)).cross(chord.V.row(2) - chord.V.row(0))).z(), 0);
+  EXPECT_EQ(audit_map_direction(chord, chord.V, slab).flipped, 0);
+  EXPECT_EQ(audit_map_direction(reversed(chord), chord.V, slab).flipped, 1);
+}
+
 TEST(MapAudit, ReflectionFlipsEveryTriangle) {
   // x -> -x maps the icosphere onto itself: every image is on the surface, areas and shapes are
   // kept (the distortion cannot see it), and every triangle is reversed.

@@ -1,0 +1,52 @@
+// The audit's orientation test of one image triangle (map_audit.h), shared by the audit and by
+// the stages that must judge triangles exactly as it does (map_smoothing, map_refinement).
+//
+// An image triangle (a, b, c) is a chord of the target surface: only its corners lie on it. It
+// is flipped when its normal faces away from the target's outward normal nearby, which is
+// estimated from the distinct target faces closest to points of the chord, area-weighted:
+//   1. the centroid and the three corners; if the chord faces along their sum, it is good;
+//   2. otherwise a second, finer look: the faces closest to the 15 points of the barycentric grid
+//      of order 4 (corners and edge points included) and the centroid; flipped only if the
+//      chord faces away from their sum too.
+// The first look alone misjudges chords whose corners lie on opposite faces of P — across a thin
+// part, or a staircase P makes of a sloped model face (rotor: a chamfer triangle whose image runs
+// from one end cap of a rod of P to the other, its normal within 10° of the model triangle's, and
+// the faces nearest its corners summing to nearly zero): the sign is then the residue of a
+// cancellation. The grid sees the faces the chord passes over. A chord reversed on one face, or
+// folded wrongly across an edge, faces away from every face near it and stays flipped.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <vector>
+
+namespace polycube {
+
+// closest(p, seed) -> the target face closest to p (seed: a face near p, or -1; only a hint).
+// area_vectors[f]: twice the area times the outward unit normal of target face f.
+// fa, fb, fc: the faces closest to a, b, c.
+template <class ClosestFace>
+bool image_triangle_flipped(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc,
+                            const std::vector<Eigen::Vector3d>& area_vectors, const ClosestFace& closest) {
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  std::vector<int> faces = {closest((a + b + c) / 3, fa), fa, fb, fc};
+  auto faces_away = [&]() {
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    Eigen::Vector3d nearby = Eigen::Vector3d::Zero();
+    for (int f : faces) nearby += area_vectors[f];
+    return n.dot(nearby) <= 0;
+  };
+  if (!faces_away()) return false;
+  constexpr int kOrder = 4;
+  for (int i = 0; i <= kOrder; ++i)
+    for (int j = 0; i + j <= kOrder; ++j) {
+      const int k = kOrder - i - j;
+      if (i == kOrder || j == kOrder || k == kOrder) continue;  // the corners: already there
+      faces.push_back(closest((i * a + j * b + k * c) / kOrder, i >= j && i >= k ? fa : (j >= k ? fb : fc)));
+    }
+  return faces_away();
+}
+
+}  // namespace polycube
