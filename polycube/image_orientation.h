@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <vector>
 
 namespace polycube {
@@ -30,21 +31,28 @@ template <class ClosestFace>
 bool image_triangle_flipped(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc,
                             const std::vector<Eigen::Vector3d>& area_vectors, const ClosestFace& closest) {
   const Eigen::Vector3d n = (b - a).cross(c - a);
-  std::vector<int> faces = {closest((a + b + c) / 3, fa), fa, fb, fc};
+  constexpr int kOrder = 4;
+  // The centroid, the corners, then the grid's points off the corners: at most 4 + 12 faces
+  // (a fixed array: this runs for every triangle the smoothing's guard judges).
+  std::array<int, 16> faces{};
+  int count = 0;
+  faces[count++] = closest((a + b + c) / 3, fa);
+  faces[count++] = fa;
+  faces[count++] = fb;
+  faces[count++] = fc;
   auto faces_away = [&]() {
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    std::sort(faces.begin(), faces.begin() + count);
+    count = static_cast<int>(std::unique(faces.begin(), faces.begin() + count) - faces.begin());
     Eigen::Vector3d nearby = Eigen::Vector3d::Zero();
-    for (int f : faces) nearby += area_vectors[f];
+    for (int k = 0; k < count; ++k) nearby += area_vectors[faces[k]];
     return n.dot(nearby) <= 0;
   };
   if (!faces_away()) return false;
-  constexpr int kOrder = 4;
   for (int i = 0; i <= kOrder; ++i)
     for (int j = 0; i + j <= kOrder; ++j) {
       const int k = kOrder - i - j;
       if (i == kOrder || j == kOrder || k == kOrder) continue;  // the corners: already there
-      faces.push_back(closest((i * a + j * b + k * c) / kOrder, i >= j && i >= k ? fa : (j >= k ? fb : fc)));
+      faces[count++] = closest((i * a + j * b + k * c) / kOrder, i >= j && i >= k ? fa : (j >= k ? fb : fc));
     }
   return faces_away();
 }

@@ -91,7 +91,7 @@ double uv_area(const DiskEmbedding& disk, int f);
 
 // Crowding. A harmonic map squeezes a part of the piece behind a narrow neck exponentially in
 // the neck's length over its girth: a blind pocket or a thin finger lying between two cutting
-// planes (femur: a canal of ~100 vertices whose disk triangles have 1e-25 of their share of the
+// planes (femur: a canal of about 100 vertices whose disk triangles have 1e-25 of their share of the
 // area). The other side's disk has no such part, so the map sends it to a point of the other
 // surface (degenerate images), and the other side's triangles never reach it (lost area).
 // decrowd_disk re-solves the disk with the weights of the edges of crowded faces lowered
@@ -105,10 +105,11 @@ double uv_area(const DiskEmbedding& disk, int f);
 //   stop        iterations end when every ratio is at or above it
 // The iterate with the largest smallest ratio is kept (the input when none is better); an
 // iterate with a flipped face (rounding in extreme weights) ends the iterations.
-// Defaults measured on the shipped meshes (bench/map.md, bench/quad.md): 1e-6 / 1e-3 / 1e-5 fixed
-// only femur's canal; these also give cow's hooves and elephant's trunk tip more of P (quad
-// Hausdorff femur 3.6 → 2.5 %, cow 11.6 → 8.9 %, elephant 0.62 → 0.45 %; the map's ε_angle lower
-// on all three) and leave the paper models exactly as they were.
+// Defaults measured on the shipped meshes (bench/map.md, bench/quad.md; this step alone, before the
+// audit's second look changed the orientations kept): 1e-6 / 1e-3 / 1e-5 fixed only femur's canal;
+// these also give cow's hooves and elephant's trunk tip more of P (quad Hausdorff femur 3.6 → 2.5 %,
+// cow 11.6 → 8.9 %, elephant 0.62 → 0.45 %; the map's ε_angle lower on all three) and leave the
+// paper models exactly as they were.
 struct DecrowdOptions {
   double trigger = 1e-2;
   double target = 1e-1;

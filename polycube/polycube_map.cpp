@@ -131,32 +131,42 @@ Eigen::Vector3d disk_point(const DiskEmbedding& disk, int f, const Eigen::Vector
   return p;
 }
 
-// Per face of `disk`: the share of the other side's area its image covers (through the other
-// disk, as a chord triangle) over its own share of its side's area.
-std::vector<double> image_area_ratio(const DiskEmbedding& disk, const DiskEmbedding& other, const DiskLocator& other_locator) {
-  const int n = disk.mesh.num_vertices();
-  std::vector<Eigen::Vector3d> image(n);
-  for (int v = 0; v < n; ++v) {
-    Eigen::Vector3d w;
-    const int f = other_locator.locate(disk.uv.row(v).transpose(), w);
-    image[v] = disk_point(other, f, w, false);
+// Per face of a disk: the share of the other side's area its image covers (through the other
+// disk, as a chord triangle) over its own share of its side's area. The areas that do not move
+// with the disk's uv are computed once.
+class ImageAreaRatio {
+ public:
+  ImageAreaRatio(const DiskEmbedding& disk, const DiskEmbedding& other, const DiskLocator& other_locator)
+      : other_(other), locator_(other_locator), share_(face_areas(disk.mesh)) {
+    const Eigen::VectorXd other_faces = face_areas(other.mesh);
+    double own_area = 0;  // sums in face order
+    for (double a : share_) own_area += a;
+    for (double a : other_faces) other_area_ += a;
+    for (double& a : share_) a /= own_area;
   }
-  auto area = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) { return 0.5 * (b - a).cross(c - a).norm(); };
-  double own_total = 0, other_total = 0;
-  for (int f = 0; f < other.mesh.num_faces(); ++f)
-    other_total += area(other.mesh.V.row(other.mesh.F(f, 0)), other.mesh.V.row(other.mesh.F(f, 1)), other.mesh.V.row(other.mesh.F(f, 2)));
-  std::vector<double> own(disk.mesh.num_faces()), ratio(disk.mesh.num_faces());
-  for (int f = 0; f < disk.mesh.num_faces(); ++f) {
-    own[f] = area(disk.mesh.V.row(disk.mesh.F(f, 0)), disk.mesh.V.row(disk.mesh.F(f, 1)), disk.mesh.V.row(disk.mesh.F(f, 2)));
-    own_total += own[f];
+
+  std::vector<double> operator()(const DiskEmbedding& disk) const {
+    std::vector<Eigen::Vector3d> image(disk.mesh.num_vertices());
+    for (int v = 0; v < disk.mesh.num_vertices(); ++v) {
+      Eigen::Vector3d w;
+      const int f = locator_.locate(disk.uv.row(v).transpose(), w);
+      image[v] = disk_point(other_, f, w, false);
+    }
+    std::vector<double> ratio(disk.mesh.num_faces(), 1.0);
+    for (int f = 0; f < disk.mesh.num_faces(); ++f) {
+      const Eigen::Vector3d& a = image[disk.mesh.F(f, 0)];
+      const double image_share = 0.5 * (image[disk.mesh.F(f, 1)] - a).cross(image[disk.mesh.F(f, 2)] - a).norm() / other_area_;
+      if (share_[f] > 0) ratio[f] = image_share / share_[f];
+    }
+    return ratio;
   }
-  for (int f = 0; f < disk.mesh.num_faces(); ++f) {
-    const double share = own[f] / own_total;
-    const double image_share = area(image[disk.mesh.F(f, 0)], image[disk.mesh.F(f, 1)], image[disk.mesh.F(f, 2)]) / other_total;
-    ratio[f] = share > 0 ? image_share / share : 1.0;
-  }
-  return ratio;
-}
+
+ private:
+  const DiskEmbedding& other_;
+  const DiskLocator& locator_;
+  Eigen::VectorXd share_;
+  double other_area_ = 0;
+};
 
 }  // namespace
 
@@ -636,12 +646,12 @@ PolycubeMap build_polycube_map(const TriMesh& model, const PolycubeResult& resul
     P.disk = embed(cut_p, walk_p);
     P.locator = std::make_unique<DiskLocator>(P.disk.uv, P.disk.mesh.F);
     // Parts of M_j that its disk squeezes and P_j's does not (pockets, fingers between the planes).
-    const DecrowdResult decrowd = decrowd_disk(M.disk, [&](const DiskEmbedding& disk) { return image_area_ratio(disk, P.disk, *P.locator); });
+    const DecrowdResult decrowd = decrowd_disk(M.disk, ImageAreaRatio(M.disk, P.disk, *P.locator));
     stats.decrowd_iterations = decrowd.iterations;
     stats.min_area_ratio_before = decrowd.min_ratio_before;
     stats.min_area_ratio = decrowd.min_ratio_after;
+    M.locator = std::make_unique<DiskLocator>(M.disk.uv, M.disk.mesh.F);  // after the re-weighting moved M's uv
     for (SideDisk* side : {&M, &P}) {
-      if (side == &M) side->locator = std::make_unique<DiskLocator>(side->disk.uv, side->disk.mesh.F);
       side->vertex_copy.assign(side->work.num_vertices(), -1);
       for (size_t v = 0; v < side->disk.vertex_origin.size(); ++v) {
         const int o = side->disk.vertex_origin[v];
