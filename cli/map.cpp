@@ -354,7 +354,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     nlohmann::json candidates = nlohmann::json::array();
     for (const AlignmentCandidate& c : alignment.candidates)
       candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle}, {"eps_area", c.eps_area},
-                            {"fallback_budget", c.fallback_budget}, {"seconds", c.seconds}, {"error", c.error}});
+                            {"fallback_budget", c.fallback_budget}, {"failing_slabs", c.failing_slabs}, {"seconds", c.seconds}, {"error", c.error}});
     report["alignment"]["candidates"] = candidates;
     report["alignment"]["proxy_faces"] = alignment.proxy_faces;
     if (alignment.proxy_faces > 0)

@@ -27,8 +27,11 @@ namespace polycube {
 // One orientation tried: x_aligned = rotation * x_input (a proper rotation).
 //   corners  of the polycube built in it (-1 if the stages failed there, see error)
 //   flipped, eps_angle, eps_area  of its map before smoothing, both directions (-1 if not mapped)
-//   fallback_budget  its polycube was built by the fallback (no candidate passed the scoring
-//            budget): four times that budget, or the caller's full one
+//   fallback_budget  its polycube was built with more than the scoring budget: by the fallback (no
+//            candidate passed the scoring budget: four times that budget, or the caller's full
+//            one), or as a near miss given a second chance (four times the budget)
+//   failing_slabs  when the scoring budget's repair rounds ran out: the slabs still failing
+//            (RepairRoundsExhausted); 0 otherwise
 struct AlignmentCandidate {
   std::string name;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
@@ -37,6 +40,7 @@ struct AlignmentCandidate {
   double eps_angle = -1;
   double eps_area = -1;
   bool fallback_budget = false;
+  int failing_slabs = 0;
   double seconds = 0;
   std::string error;
 };
@@ -116,6 +120,10 @@ struct AlignmentOptions {
   // (the fewest corners win) and, if none passes, with the caller's full budget, in order, until
   // one succeeds (chosen is then that one, with its topology and polycube but no map).
   bool full_budget_fallback = true;
+  // When every mapped candidate has flips, a candidate whose repair rounds ran out with at most
+  // this many slabs still failing (AlignmentCandidate::failing_slabs) is built again with four
+  // times the scoring budget and mapped, and competes with the others. 0: never.
+  int near_miss_slabs = 2;
   // A model with fewer vertices than coarse_below (and no target_vertices asked for) also tries
   // its mapped candidates with P triangulated by at least fine_polycube_vertices vertices; the
   // map with the fewest flips still wins. 0: never.

@@ -364,8 +364,9 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
     result.seconds_checks += seconds_since(t);
     if (failing == 0) break;
     if (round >= options.max_rounds)
-      throw AlgorithmError("build_polycube: " + std::to_string(failing) + " slabs still fail after " +
-                           std::to_string(round) + " rounds; first: " + first_problem);
+      throw RepairRoundsExhausted("build_polycube: " + std::to_string(failing) + " slabs still fail after " +
+                                      std::to_string(round) + " rounds; first: " + first_problem,
+                                  failing);
     if (!inserted.empty()) {
       t = Clock::now();
       result.planes_inserted += static_cast<int>(inserted.size());

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "polycube/contour_sections.h"
+#include "polycube/errors.h"
 #include "polycube/mesh.h"
 #include "polycube/polycube_surface.h"
 #include "polycube/slice.h"
@@ -126,5 +127,14 @@ struct PolycubeResult {
 // Throws AlgorithmError when the repairs exceed their limits or P fails its final check — an
 // invalid polycube is never returned — and std::invalid_argument for inconsistent inputs.
 PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topology, const PolycubeOptions& options = {});
+
+// What build_polycube throws when its check-and-repair rounds (PolycubeOptions::max_rounds) run
+// out with slabs still failing: a budget that ran out, where more rounds may succeed, rather than a
+// cross-section that cannot be approximated within the limits.
+class RepairRoundsExhausted : public AlgorithmError {
+ public:
+  RepairRoundsExhausted(const std::string& message, int failing_slabs) : AlgorithmError(message), failing_slabs(failing_slabs) {}
+  int failing_slabs;
+};
 
 }  // namespace polycube

@@ -233,4 +233,50 @@ TEST(Align, ChoosesTheMappedCandidateWithFewestFlips) {
 }
 
 }  // namespace
+// A candidate whose repair rounds ran out with few slabs still failing is a near miss: when every
+// map tried has flips, it gets four times the scoring budget and its map, and competes; one that
+// failed otherwise, or with more slabs failing, is not built again.
+TEST(Align, NearMissesGetASecondChanceWhenEveryMapFlips) {
+  const TriMesh model = load_test_mesh("rotor.off");
+  AlignmentOptions tight;
+  tight.max_rounds = 3;  // rotor: four orientations run out of rounds, three with 1 slab failing, one with 2
+  tight.near_miss_slabs = 0;
+  const Alignment first = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, tight);
+  int near = 0, mapped_clean = 0;
+  for (const AlignmentCandidate& c : first.candidates) {
+    EXPECT_FALSE(c.fallback_budget) << c.name;
+    if (c.failing_slabs > 0) {
+      EXPECT_LT(c.corners, 0) << c.name;
+      EXPECT_NE(c.error.find("still fail after 3 rounds"), std::string::npos) << c.error;
+      near += c.failing_slabs <= 1;
+    }
+    mapped_clean += c.flipped == 0;
+  }
+  ASSERT_GT(near, 0);
+  ASSERT_EQ(mapped_clean, 0);
+  tight.near_miss_slabs = 1;
+  const Alignment second = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, tight);
+  int rebuilt = 0;
+  for (size_t i = 0; i < first.candidates.size(); ++i) {
+    const AlignmentCandidate &a = first.candidates[i], &b = second.candidates[i];
+    if (a.name.find("finer P") != std::string::npos) break;  // the variants follow the orientations
+    EXPECT_EQ(a.name, b.name);
+    if (a.corners >= 0) {
+      EXPECT_EQ(b.corners, a.corners) << a.name;
+      EXPECT_FALSE(b.fallback_budget) << a.name;
+    } else if (a.failing_slabs == 1) {
+      EXPECT_TRUE(b.corners >= 0 || !b.error.empty()) << a.name;
+      if (b.corners >= 0) {
+        ++rebuilt;
+        EXPECT_TRUE(b.fallback_budget) << a.name;
+        EXPECT_GE(b.flipped, 0) << a.name << " was not mapped";
+      }
+    } else {
+      EXPECT_LT(b.corners, 0) << a.name << " was built again";
+      EXPECT_EQ(b.error, a.error) << a.name;
+    }
+  }
+  EXPECT_GT(rebuilt, 0);
+}
+
 }  // namespace polycube
