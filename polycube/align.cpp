@@ -242,6 +242,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       polycubes[i].reset();
     } catch (const Error& e) {
       c.error = e.what();
+      c.failing_slabs = 0;
       polycubes[i].reset();
     }
     c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -30,8 +30,8 @@ namespace polycube {
 //   fallback_budget  its polycube was built with more than the scoring budget: by the fallback (no
 //            candidate passed the scoring budget: four times that budget, or the caller's full
 //            one), or as a near miss given a second chance (four times the budget)
-//   failing_slabs  when the scoring budget's repair rounds ran out: the slabs still failing
-//            (RepairRoundsExhausted); 0 otherwise
+//   failing_slabs  when its last polycube build ran out of repair rounds (RepairRoundsExhausted):
+//            the slabs still failing; 0 otherwise
 struct AlignmentCandidate {
   std::string name;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
