@@ -305,10 +305,14 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   if (options.mapped_candidates > 0) {
     const size_t first = std::min(mapped.size(), static_cast<size_t>(options.mapped_candidates));
     map_candidates(std::vector<int>(mapped.begin(), mapped.begin() + first));
+    // Some map built so far without a flipped triangle?
+    auto any_clean = [&]() {
+      for (size_t i = 0; i < maps.size(); ++i)
+        if (maps[i] && out.candidates[i].flipped == 0) return true;
+      return false;
+    };
     // Still flips in every map tried: the others get their map too.
-    bool clean = false;
-    for (size_t k = 0; k < first; ++k) clean = clean || (maps[mapped[k]] && out.candidates[mapped[k]].flipped == 0);
-    if (!clean && first < mapped.size()) map_candidates(std::vector<int>(mapped.begin() + first, mapped.end()));
+    if (!any_clean() && first < mapped.size()) map_candidates(std::vector<int>(mapped.begin() + first, mapped.end()));
     // Still flips in every map: the near misses — candidates whose repair rounds ran out with at
     // most near_miss_slabs slabs still failing — get four times the scoring budget and are mapped
     // when they build. The repairs of one orientation can need a few rounds more for a turned copy
@@ -316,8 +320,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     // rounds, and only the normals' frame, 167 / 66 flips, was left to map; in its own frame they
     // build, 641 corners, 2 / 9). Other failures are not retried: with four times the budget, one
     // of the same cow's (8 slabs failing) took 118 s to fail again.
-    for (int i = 0; i < n && !clean; ++i) clean = maps[i] && out.candidates[i].flipped == 0;
-    if (!clean && !mapped.empty() && options.near_miss_slabs > 0) {
+    if (!any_clean() && !mapped.empty() && options.near_miss_slabs > 0) {
       std::vector<int> failed;
       for (int i = 0; i < n; ++i)
         if (!polycubes[i] && out.candidates[i].failing_slabs > 0 && out.candidates[i].failing_slabs <= options.near_miss_slabs)

@@ -232,7 +232,6 @@ TEST(Align, ChoosesTheMappedCandidateWithFewestFlips) {
   EXPECT_EQ(choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, plain).candidates.size(), 6u);
 }
 
-}  // namespace
 // A candidate whose repair rounds ran out with few slabs still failing is a near miss: when every
 // map tried has flips, it gets four times the scoring budget and its map, and competes; one that
 // failed otherwise, or with more slabs failing, is not built again.
@@ -279,4 +278,5 @@ TEST(Align, NearMissesGetASecondChanceWhenEveryMapFlips) {
   EXPECT_GT(rebuilt, 0);
 }
 
+}  // namespace
 }  // namespace polycube
