@@ -136,6 +136,15 @@ MapRefinementResult refine_map_sampling(const TriMesh& model, const PolycubeResu
 // a triangle is read as its chord projected to the closest point of the model, the reading
 // `polycube quad` makes of the written files. Used after the smoothing, which moves images off
 // the places the first refinement put them (chords across the model's edges lose area again).
+// Where those bisections leave the image area short by more than area_tolerance, the refinement
+// is run again with a second kind of split, and the better result kept (fewer bad triangles of
+// both directions, then of P → M, then the area): a P edge whose images lie in two model faces
+// round a common model vertex is split where the straight line between them, over those faces
+// unfolded about the vertex, crosses the edge it leaves the first face by, its new image exactly
+// on that model edge. Halves that still cross are split again in later rounds, so chords come to
+// lie in one closed model face each, where they lose nothing: on a CAD part's sharp edges the
+// midpoint bisections gain area only in proportion to their count (a tetrahedron's smoothed map:
+// 0.85 → 0.87 with 10 000 more vertices; with the edge splits 0.98 with 200).
 //   polycube  the P the samples belong to (e.g. refine_map_sampling's refined P)
 //   planes_z  heights new vertices are put on where edges cross them (PolycubeResult::planes_z)
 //   samples   polycube_on_model(_xyz), model_on_polycube(_xyz) at that P's vertices

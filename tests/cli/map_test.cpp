@@ -145,12 +145,12 @@ TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
 }
 
 // When the winner's finished map (refined, smoothed) still has flips or P's image misses 2 % of the area,
-// the search's next candidates are finished too and the best finished map is written: torus_quad
-// (25 vertices) ends its winner with 97 % of the area. The kept one ranks first by flips, then
+// the search's next candidates are finished too and the best finished map is written: helmet
+// (1000 triangles) ends its winner with 2 flipped P → M triangles. The kept one ranks first by flips, then
 // whether it meets that contract, then ε_angle; the files and the report are its, in its frame.
 TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   const std::string dir = test::temp_dir("map-retry");
-  const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("torus_quad.off")) + " -o " + quoted(dir));
+  const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path("helmet.off")) + " -o " + quoted(dir));
   ASSERT_EQ(run.code, 0) << run.err;
   const auto report = read_json(dir + "/report.json");
   ASSERT_TRUE(report.at("alignment").contains("finished")) << "the winner's finished map met the contract: pick another mesh";
@@ -185,7 +185,7 @@ TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   // the model's images lie on it.
   EXPECT_EQ(tilted_faces(dir + "/polycube.obj", report_rotation(report)), 0);
   EXPECT_LT(map.at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
-  EXPECT_EQ(read_polygon_soup(dir + "/model_on_polycube.obj").points.size(), read_polygon_soup(test::data_path("torus_quad.off")).points.size());
+  EXPECT_EQ(read_polygon_soup(dir + "/model_on_polycube.obj").points.size(), read_polygon_soup(test::data_path("helmet.off")).points.size());
 }
 
 TEST(MapCli, QuietRunPrintsNothing) {
