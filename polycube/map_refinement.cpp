@@ -483,7 +483,6 @@ class Refiner {
       any = true;
     }
     journal_.clear();
-    if (std::getenv("PC_DEBUG")) fprintf(stderr, "cross: missing %g need %g candidates %zu gained %g vertices %zu\n", missing / target_.area(), need / target_.area(), candidates.size(), gained / target_.area(), now_.position.size());
     return any;
   }
 
