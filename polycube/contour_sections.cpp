@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace polycube {
 
@@ -168,6 +170,65 @@ CrossSections cross_sections(const SlicedMesh& sliced, const NormalisedFrame& fr
     section.face_area[0] = 0;
   }
   return result;
+}
+
+int count_contour_crossings(const CrossSections& sections, int plane, Eigen::Vector2d* where) {
+  // Segments (contour, index) bucketed into a uniform grid by their bounding boxes; pairs in a
+  // common cell are tested, neighbours along one contour skipped.
+  struct Segment {
+    int contour, index;
+    Eigen::Vector2d a, b;
+  };
+  std::vector<Segment> segments;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const int c : sections.planes.at(plane).contours) {
+    const std::vector<Eigen::Vector2d>& points = sections.contours[c].points;
+    const int n = static_cast<int>(points.size());
+    for (int k = 0; k < n; ++k) {
+      segments.push_back({c, k, points[k], points[(k + 1) % n]});
+      lo = lo.cwiseMin(points[k]);
+      hi = hi.cwiseMax(points[k]);
+    }
+  }
+  if (segments.size() < 2) return 0;
+  const int cells = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(segments.size()))), 1, 1024);
+  const Eigen::Vector2d size = ((hi - lo) / cells).cwiseMax(1e-300);
+  auto cell_of = [&](const Eigen::Vector2d& p, int axis) {
+    return std::clamp(static_cast<int>((p[axis] - lo[axis]) / size[axis]), 0, cells - 1);
+  };
+  std::vector<std::vector<int>> bucket(static_cast<size_t>(cells) * cells);
+  for (size_t s = 0; s < segments.size(); ++s) {
+    const Segment& g = segments[s];
+    const Eigen::Vector2d a = g.a.cwiseMin(g.b), b = g.a.cwiseMax(g.b);
+    for (int i = cell_of(a, 0); i <= cell_of(b, 0); ++i)
+      for (int j = cell_of(a, 1); j <= cell_of(b, 1); ++j) bucket[static_cast<size_t>(i) * cells + j].push_back(static_cast<int>(s));
+  }
+  auto orientation = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
+    const double d = (q.x() - p.x()) * (r.y() - p.y()) - (q.y() - p.y()) * (r.x() - p.x());
+    return (d > 0) - (d < 0);
+  };
+  std::vector<std::pair<int, int>> crossing;
+  for (const std::vector<int>& in : bucket)
+    for (size_t x = 0; x < in.size(); ++x)
+      for (size_t y = x + 1; y < in.size(); ++y) {
+        const Segment &g = segments[in[x]], &h = segments[in[y]];
+        if (g.contour == h.contour) {
+          const int n = static_cast<int>(sections.contours[g.contour].points.size());
+          const int d = std::abs(g.index - h.index);
+          if (d <= 1 || d == n - 1) continue;
+        }
+        if (orientation(g.a, g.b, h.a) * orientation(g.a, g.b, h.b) < 0 && orientation(h.a, h.b, g.a) * orientation(h.a, h.b, g.b) < 0)
+          crossing.emplace_back(std::min(in[x], in[y]), std::max(in[x], in[y]));
+      }
+  std::sort(crossing.begin(), crossing.end());
+  crossing.erase(std::unique(crossing.begin(), crossing.end()), crossing.end());
+  if (!crossing.empty() && where) {
+    const Segment &g = segments[crossing.front().first], &h = segments[crossing.front().second];
+    const Eigen::Vector2d r = g.b - g.a, q = h.b - h.a;
+    const double t = ((h.a - g.a).x() * q.y() - (h.a - g.a).y() * q.x()) / (r.x() * q.y() - r.y() * q.x());
+    *where = g.a + t * r;
+  }
+  return static_cast<int>(crossing.size());
 }
 
 }  // namespace polycube

@@ -83,4 +83,10 @@ struct CrossSections {
 // outer contour — signs of a self-intersecting surface).
 CrossSections cross_sections(const SlicedMesh& sliced, const NormalisedFrame& frame);
 
+// Pairs of contour segments of one plane that cross (a contour crossing another or itself): a
+// self-intersecting surface cut where it intersects itself. No axis-aligned approximation of
+// such a section has its topology (regions overlap), so no refinement can repair it.
+//   where  if given and the count is positive: a crossing point, in the normalised frame
+int count_contour_crossings(const CrossSections& sections, int plane, Eigen::Vector2d* where = nullptr);
+
 }  // namespace polycube

@@ -196,9 +196,22 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
           unusable.push_back(i);
           continue;
         }
-        if (!state.quadtree.valid)
+        if (!state.quadtree.valid) {
+          // Name the likely cause: a self-intersecting surface cut where it meets itself.
+          Eigen::Vector2d at;
+          const int crossings = count_contour_crossings(sections, i, &at);
+          std::string cause;
+          if (crossings > 0) {
+            const Eigen::Vector2d xy = frame.origin.head<2>() + frame.scale * at;
+            std::ostringstream where;
+            where << "; its contours cross each other at " << crossings << " point" << (crossings > 1 ? "s" : "") << ", e.g. ("
+                  << xy.x() << ", " << xy.y() << ", " << sliced.planes[i]
+                  << "): the surface intersects itself there (remove the self-intersections `inspect` counts)";
+            cause = where.str();
+          }
           throw AlgorithmError("build_polycube: cross-section cannot be approximated with its topology: " +
-                               state.quadtree.problem);
+                               state.quadtree.problem + cause);
+        }
       }
       leaves[i] = &state.quadtree.leaves;
     }

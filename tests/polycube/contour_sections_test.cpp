@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <map>
+#include <vector>
 
 namespace polycube {
 namespace {
@@ -113,6 +114,43 @@ TEST(ContourSections, PlaneOrderDoesNotDependOnOtherPlanes) {
     EXPECT_EQ(a.points, b.points);
     EXPECT_EQ(a.parent, b.parent);
   }
+}
+
+// Contours crossing each other or themselves (a self-intersecting surface cut where it meets
+// itself) are counted, pair by pair of segments; disjoint, nested and touching-at-a-shared-corner
+// segments of one contour are not.
+TEST(ContourSections, CrossingContoursAreCounted) {
+  auto square = [](double x0, double y0, double side) {
+    return std::vector<Eigen::Vector2d>{{x0, y0}, {x0 + side, y0}, {x0 + side, y0 + side}, {x0, y0 + side}};
+  };
+  auto sections_of = [](const std::vector<std::vector<Eigen::Vector2d>>& contours) {
+    CrossSections sections;
+    sections.planes.resize(1);
+    for (const auto& points : contours) {
+      sections.planes[0].contours.push_back(static_cast<int>(sections.contours.size()));
+      SectionContour c;
+      c.points = points;
+      sections.contours.push_back(c);
+    }
+    return sections;
+  };
+  EXPECT_EQ(count_contour_crossings(sections_of({square(0, 0, 1), square(2, 0, 1)}), 0), 0);
+  EXPECT_EQ(count_contour_crossings(sections_of({square(0, 0, 3), square(1, 1, 1)}), 0), 0);
+  // Two squares overlapping at a corner: two crossing pairs, at (1, 0.5) and (0.5, 1).
+  Eigen::Vector2d at;
+  EXPECT_EQ(count_contour_crossings(sections_of({square(0, 0, 1), square(0.5, 0.5, 1)}), 0, &at), 2);
+  EXPECT_TRUE((at - Eigen::Vector2d(1, 0.5)).norm() < 1e-12 || (at - Eigen::Vector2d(0.5, 1)).norm() < 1e-12) << at.transpose();
+  // A bow tie crosses itself once.
+  EXPECT_EQ(count_contour_crossings(sections_of({{{0, 0}, {1, 1}, {1, 0}, {0, 1}}}), 0), 1);
+  // Many segments (the grid path): a fine circle and a shifted copy cross twice.
+  std::vector<Eigen::Vector2d> circle, shifted;
+  for (int k = 0; k < 400; ++k) {
+    const double t = 2 * kPi * (k + 0.5) / 400;
+    circle.emplace_back(std::cos(t), std::sin(t));
+    shifted.emplace_back(std::cos(t) + 0.5, std::sin(t));
+  }
+  EXPECT_EQ(count_contour_crossings(sections_of({circle}), 0), 0);
+  EXPECT_EQ(count_contour_crossings(sections_of({circle, shifted}), 0), 2);
 }
 
 }  // namespace
