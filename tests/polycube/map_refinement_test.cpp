@@ -180,17 +180,23 @@ TEST(MapRefinement, NeverWorse) {
   }
 }
 
-// After the smoothing, which moves images off the model's edges (chords lose area again), the
-// second refinement samples the smoothed map: same surface, no new bad triangle, area closer.
-TEST(MapRefinement, AfterSmoothingSamplesTheSmoothedMap) {
-  const Pipeline& p = pipeline("sphere.off");
-  const MapRefinementResult first = refine_map_sampling(p.model, p.polycube, p.map);
-  const MapSmoothingResult smoothed = smooth_map(p.model, first.polycube, first.map);
+// The first refinement's sampling smoothed, as the vertex samples the second refinement takes.
+PolycubeMap smoothed_samples(const TriMesh& model, const MapRefinementResult& first) {
+  const MapSmoothingResult smoothed = smooth_map(model, first.polycube, first.map);
   PolycubeMap samples;
   samples.polycube_on_model = smoothed.polycube_on_model;
   samples.polycube_on_model_xyz = smoothed.polycube_on_model_xyz;
   samples.model_on_polycube = smoothed.model_on_polycube;
   samples.model_on_polycube_xyz = smoothed.model_on_polycube_xyz;
+  return samples;
+}
+
+// After the smoothing, which moves images off the model's edges (chords lose area again), the
+// second refinement samples the smoothed map: same surface, no new bad triangle, area closer.
+TEST(MapRefinement, AfterSmoothingSamplesTheSmoothedMap) {
+  const Pipeline& p = pipeline("sphere.off");
+  const MapRefinementResult first = refine_map_sampling(p.model, p.polycube, p.map);
+  const PolycubeMap samples = smoothed_samples(p.model, first);
   const MapDirectionAudit input = audit_map_direction(first.polycube.mesh, samples.polycube_on_model_xyz, p.model);
   const MapRefinementResult second = refine_vertex_map_sampling(p.model, first.polycube, p.polycube.planes_z, samples);
   expect_same_polycube(first.polycube, second.polycube, p.polycube.genus);
@@ -223,12 +229,7 @@ std::vector<int> closure_faces(const TriMesh& model, const SurfacePoint& y) {
 TEST(MapRefinement, SplitsWhereImagesCrossSharpModelEdges) {
   const Pipeline& p = pipeline("tetrahedron.off");
   const MapRefinementResult first = refine_map_sampling(p.model, p.polycube, p.map);
-  const MapSmoothingResult smoothed = smooth_map(p.model, first.polycube, first.map);
-  PolycubeMap samples;
-  samples.polycube_on_model = smoothed.polycube_on_model;
-  samples.polycube_on_model_xyz = smoothed.polycube_on_model_xyz;
-  samples.model_on_polycube = smoothed.model_on_polycube;
-  samples.model_on_polycube_xyz = smoothed.model_on_polycube_xyz;
+  const PolycubeMap samples = smoothed_samples(p.model, first);
   const MapDirectionAudit input = audit_map_direction(first.polycube.mesh, samples.polycube_on_model_xyz, p.model);
   ASSERT_LT(input.area_ratio, 0.9);  // else this proves nothing
 
