@@ -29,6 +29,19 @@ Eigen::Vector3d row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpos
 
 }  // namespace
 
+double triangle_angle_distortion(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3]) {
+  const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+  const double image_area = 0.5 * (q[1] - q[0]).cross(q[2] - q[0]).norm();
+  if (!(area > 0 && image_area > 0)) return std::numeric_limits<double>::infinity();
+  // cot(angle at p_c) = (e·e') / (2 A(T)) for the two edges e, e' leaving p_c.
+  double energy = 0;
+  for (int c = 0; c < 3; ++c) {
+    const int a = (c + 1) % 3, b = (c + 2) % 3;
+    energy += (p[a] - p[c]).dot(p[b] - p[c]) * (q[b] - q[a]).squaredNorm();
+  }
+  return energy / (2 * area) / (4 * image_area);
+}
+
 DistortionStats map_distortion(const TriMesh& domain, const Eigen::MatrixX3d& image) {
   const int nv = domain.num_vertices(), nf = domain.num_faces();
   if (nf == 0) throw std::invalid_argument("map_distortion: domain has no faces");
@@ -71,14 +84,9 @@ DistortionStats map_distortion(const TriMesh& domain, const Eigen::MatrixX3d& im
     const Eigen::Vector3d p[3] = {row(domain.V, domain.F(f, 0)), row(domain.V, domain.F(f, 1)),
                                   row(domain.V, domain.F(f, 2))};
     const Eigen::Vector3d q[3] = {row(image, domain.F(f, 0)), row(image, domain.F(f, 1)), row(image, domain.F(f, 2))};
-    // cot(angle at p_i) = (e·e') / (2 A(T)) for the two edges leaving p_i; both cotangent and the
-    // ratio a'²/A(T') are scale-invariant, so the normalisation does not change ε_angle.
-    double energy = 0;
-    for (int c = 0; c < 3; ++c) {
-      const int a = (c + 1) % 3, b = (c + 2) % 3;
-      energy += (p[a] - p[c]).dot(p[b] - p[c]) * (q[b] - q[a]).squaredNorm();
-    }
-    const double eps_angle = energy / (2 * area[f]) / (4 * image_area[f]);
+    // Both cotangents and the ratio a'²/A(T') are scale-invariant, so the normalisation does not
+    // change ε_angle.
+    const double eps_angle = triangle_angle_distortion(p, q);
     const double ratio = (area[f] / total) / (image_area[f] / total_image);
     const double eps_area = 0.5 * (ratio + 1 / ratio);
     const double weight = image_area[f] / total_image;

@@ -42,4 +42,8 @@ struct DistortionStats {
 // vertices, zero domain area, or an image with the wrong number of rows.
 DistortionStats map_distortion(const TriMesh& domain, const Eigen::MatrixX3d& image);
 
+// ε_angle of one triangle (p0, p1, p2) → (q0, q1, q2), in the cotangent form above; +infinity
+// when either triangle has zero area.
+double triangle_angle_distortion(const Eigen::Vector3d p[3], const Eigen::Vector3d q[3]);
+
 }  // namespace polycube

@@ -1,6 +1,7 @@
 #include "polycube/map_refinement.h"
 
 #include "polycube/image_orientation.h"
+#include "polycube/map_quality.h"
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
 #include "polycube/triangle_tree.h"
@@ -37,6 +38,10 @@ constexpr double kPlaneSplitMin = 0.1;
 
 // Image triangles at or below this fraction of the target area are degenerate (the audit's).
 constexpr double kDegenerateArea = 1e-14;
+
+// A split at the model's edges is undone when its triangles' angle distortion weighted by image
+// area (as in ε_angle) exceeds that of the triangles it split plus this times the area it adds.
+constexpr double kMaxSplitDistortion = 3;
 
 Vec3 row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpose(); }
 
@@ -470,11 +475,26 @@ class Refiner {
       const Undo& r = journal_.back();
       const int bad_before = (r.state_t != 0) + (r.state_u != 0);
       int bad_after = 0;
+      double weighted_after = 0, area_after = 0;
       for (const int slot : {r.t, r.u, r.t2, r.u2}) {
         judge(slot);
         bad_after += now_.state[slot] != 0;
+        const double a = image_area(slot), d = distortion(now_.tri[slot]);
+        weighted_after += a * d;
+        area_after += a;
       }
-      if (bad_after > bad_before) {
+      // The angle distortion weighted by image area, as ε_angle weighs it: the split may add
+      // area at up to kMaxSplitDistortion, not distort what was there (the unfoldings of
+      // neighbouring splits need not agree, and a sliver on P with a fat image costs its P area
+      // times its stretch squared).
+      double weighted_before = 0, area_before = 0;
+      for (const std::array<int, 3>& corner : {r.tri_t, r.tri_u}) {
+        const double a = triangle_area(now_.image_xyz[corner[0]], now_.image_xyz[corner[1]], now_.image_xyz[corner[2]]);
+        const double d = distortion(corner);
+        weighted_before += a * d;
+        area_before += a;
+      }
+      if (bad_after > bad_before || weighted_after > weighted_before + kMaxSplitDistortion * std::max(0.0, area_after - area_before)) {
         undo_last();
         continue;
       }
@@ -487,6 +507,13 @@ class Refiner {
   }
 
   Sampling& sampling() { return now_; }
+
+  // ε_angle of the triangle with these corners: P's positions to their images.
+  double distortion(const std::array<int, 3>& corner) const {
+    const Vec3 p[3] = {now_.position[corner[0]], now_.position[corner[1]], now_.position[corner[2]]};
+    const Vec3 q[3] = {now_.image_xyz[corner[0]], now_.image_xyz[corner[1]], now_.image_xyz[corner[2]]};
+    return triangle_angle_distortion(p, q);
+  }
 
  private:
   static uint64_t directed(int a, int b) {

@@ -9,9 +9,12 @@
 #include <Eigen/LU>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <tuple>
+#include <utility>
 
 namespace polycube {
 namespace {
@@ -186,6 +189,32 @@ TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   EXPECT_EQ(tilted_faces(dir + "/polycube.obj", report_rotation(report)), 0);
   EXPECT_LT(map.at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
   EXPECT_EQ(read_polygon_soup(dir + "/model_on_polycube.obj").points.size(), read_polygon_soup(test::data_path("helmet.off")).points.size());
+}
+
+// The smoothing (§3.5) is kept only when it removes flips or lowers ε_angle: CGAL's corner.off (an
+// L-shaped block, 28 triangles) has a polycube equal to itself and a map that is conformal before
+// any smoothing; relaxing it would move its images off the model's corners. A sphere's map is
+// smoothed as before.
+TEST(MapCli, SmoothingIsKeptOnlyWhenItLowersTheDistortion) {
+  for (const auto& [mesh, expect_kept] : {std::pair<std::string, bool>{"corner.off", false}, {"sphere.off", true}}) {
+    SCOPED_TRACE(mesh);
+    const std::string dir = test::temp_dir("map-smoothing-kept");
+    const CliRun run = polycube_cli("map --quiet " + quoted(test::data_path(mesh)) + " -o " + quoted(dir));
+    ASSERT_EQ(run.code, 0) << run.err;
+    const auto report = read_json(dir + "/report.json");
+    const auto& map = report.at("map");
+    const auto& smoothing = map.at("smoothing");
+    const double before = smoothing.at("before").at("eps_angle").get<double>();
+    const double after = smoothing.at("eps_angle_after").get<double>();
+    EXPECT_EQ(smoothing.at("kept").get<bool>(), expect_kept);
+    EXPECT_EQ(smoothing.at("kept").get<bool>(), after < before);  // neither has flips to remove
+    EXPECT_EQ(map.at("polycube_to_model").at("flipped").get<int>() + map.at("model_to_polycube").at("flipped").get<int>(), 0);
+    EXPECT_LE(map.at("eps_angle").get<double>(), std::min(before, after) + 0.01);
+    if (!expect_kept) {
+      EXPECT_LT(map.at("eps_angle").get<double>(), 1.001);
+      EXPECT_GT(map.at("polycube_to_model").at("area_ratio").get<double>(), 0.99);
+    }
+  }
 }
 
 TEST(MapCli, QuietRunPrintsNothing) {
