@@ -416,8 +416,8 @@ class Refiner {
   // While P's image falls short of the model's area by more than the tolerance: splits the P
   // edges whose images cross a model edge between faces at an angle (ModelEdgeCrossing), the
   // largest area gains first, until the missing area is covered down to half the tolerance. A
-  // split is undone if its four triangles end with more bad ones than its two had. Returns
-  // whether any split was kept.
+  // split is undone if its four triangles end with more bad ones than its two had, or with more
+  // angle distortion than the area it adds is worth (below). Returns whether any split was kept.
   bool split_at_model_edges(int max_vertices) {
     const double missing = target_.area() - measure().second;
     if (missing <= options_.area_tolerance * target_.area()) return false;
@@ -479,9 +479,8 @@ class Refiner {
       for (const int slot : {r.t, r.u, r.t2, r.u2}) {
         judge(slot);
         bad_after += now_.state[slot] != 0;
-        const double a = image_area(slot), d = distortion(now_.tri[slot]);
-        weighted_after += a * d;
-        area_after += a;
+        weighted_after += weighted_distortion(now_.tri[slot]);
+        area_after += image_area(slot);
       }
       // The angle distortion weighted by image area, as ε_angle weighs it: the split may add
       // area at up to kMaxSplitDistortion, not distort what was there (the unfoldings of
@@ -489,10 +488,8 @@ class Refiner {
       // times its stretch squared).
       double weighted_before = 0, area_before = 0;
       for (const std::array<int, 3>& corner : {r.tri_t, r.tri_u}) {
-        const double a = triangle_area(now_.image_xyz[corner[0]], now_.image_xyz[corner[1]], now_.image_xyz[corner[2]]);
-        const double d = distortion(corner);
-        weighted_before += a * d;
-        area_before += a;
+        weighted_before += weighted_distortion(corner);
+        area_before += triangle_area(now_.image_xyz[corner[0]], now_.image_xyz[corner[1]], now_.image_xyz[corner[2]]);
       }
       if (bad_after > bad_before || weighted_after > weighted_before + kMaxSplitDistortion * std::max(0.0, area_after - area_before)) {
         undo_last();
@@ -508,14 +505,16 @@ class Refiner {
 
   Sampling& sampling() { return now_; }
 
-  // ε_angle of the triangle with these corners: P's positions to their images.
-  double distortion(const std::array<int, 3>& corner) const {
+ private:
+  // The image area times the angle distortion (ε_angle's summand) of the triangle with these
+  // corners: 0 for a zero-area image, +infinity for a zero-area triangle of P with an image.
+  double weighted_distortion(const std::array<int, 3>& corner) const {
     const Vec3 p[3] = {now_.position[corner[0]], now_.position[corner[1]], now_.position[corner[2]]};
     const Vec3 q[3] = {now_.image_xyz[corner[0]], now_.image_xyz[corner[1]], now_.image_xyz[corner[2]]};
-    return triangle_angle_distortion(p, q);
+    const double area = triangle_area(q[0], q[1], q[2]);
+    return area > 0 ? area * triangle_angle_distortion(p, q) : 0.0;
   }
 
- private:
   static uint64_t directed(int a, int b) {
     return (static_cast<uint64_t>(static_cast<uint32_t>(a)) << 32) | static_cast<uint32_t>(b);
   }
