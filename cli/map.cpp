@@ -218,20 +218,13 @@ std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<dou
     const DistortionStats before = map_distortion(P.mesh, out->on_model_xyz);
     MapSmoothingOptions smooth_options;
     smooth_options.sweeps = options.smooth_sweeps;
+    // Returns its input when it neither removes flips nor lowers ε_angle (smoothed.kept).
     const MapSmoothingResult smoothed = smooth_map(model, P, sampled, smooth_options);
-    // The smoothing is kept when it removes flips or lowers ε_angle, its aim; a map that is
-    // already nearly conformal (a model P matches face for face) only loses by it: relaxed
-    // images leave the model's corners and their chords cut across its edges.
-    const DistortionStats after = map_distortion(P.mesh, smoothed.polycube_on_model_xyz);
-    const bool kept = smoothed.flipped_after[0] + smoothed.flipped_after[1] < smoothed.flipped_before[0] + smoothed.flipped_before[1] ||
-                      after.eps_angle < before.eps_angle;
-    if (kept) {
-      out->on_model_xyz = smoothed.polycube_on_model_xyz;
-      out->on_polycube_xyz = smoothed.model_on_polycube_xyz;
-    }
+    out->on_model_xyz = smoothed.polycube_on_model_xyz;
+    out->on_polycube_xyz = smoothed.model_on_polycube_xyz;
     out->smooth_seconds = smoothed.seconds;
-    out->smoothing = {{"kept", kept},
-                      {"eps_angle_after", after.eps_angle},
+    out->smoothing = {{"kept", smoothed.kept},
+                      {"eps_angle_after", smoothed.eps_angle_after},
                       {"sweeps", smoothed.sweeps},
                       {"rounds", smoothed.rounds},
                       {"moves", smoothed.moves},
@@ -248,14 +241,15 @@ std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<dou
     progress.stage("smooth", std::to_string(smoothed.flipped_before[0]) + " / " + std::to_string(smoothed.flipped_before[1]) +
                                  " flipped before, " + std::to_string(smoothed.flipped_after[0]) + " / " +
                                  std::to_string(smoothed.flipped_after[1]) + " after" +
-                                 (kept ? "" : "; not kept (eps_angle " + std::to_string(before.eps_angle) + " -> " + std::to_string(after.eps_angle) + ")"));
+                                 (smoothed.kept ? "" : "; not kept (eps_angle " + std::to_string(smoothed.eps_angle_before) + " -> " +
+                                                           std::to_string(smoothed.eps_angle_after) + ")"));
     if (options.refine) {
       progress.stage("refine", "again where the smoothed map's chords flip or lose area");
       PolycubeMap samples;
-      samples.polycube_on_model = kept ? smoothed.polycube_on_model : sampled.polycube_on_model;
-      samples.polycube_on_model_xyz = out->on_model_xyz;
-      samples.model_on_polycube = kept ? smoothed.model_on_polycube : sampled.model_on_polycube;
-      samples.model_on_polycube_xyz = out->on_polycube_xyz;
+      samples.polycube_on_model = smoothed.polycube_on_model;
+      samples.polycube_on_model_xyz = smoothed.polycube_on_model_xyz;
+      samples.model_on_polycube = smoothed.model_on_polycube;
+      samples.model_on_polycube_xyz = smoothed.model_on_polycube_xyz;
       // Nothing moves the images after this: refine only where the audit's 2 % is not met
       // (it then aims at half of that).
       MapRefinementOptions resample_options;

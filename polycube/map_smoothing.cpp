@@ -2,6 +2,7 @@
 
 #include "polycube/closest_point.h"
 #include "polycube/image_orientation.h"
+#include "polycube/map_quality.h"
 
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
@@ -1233,6 +1234,18 @@ MapSmoothingResult smooth_map(const TriMesh& model, const Polycube& polycube, co
     result.polycube_on_model_xyz = std::move(current.polycube_on_model_xyz);
     result.model_on_polycube_xyz = std::move(current.model_on_polycube_xyz);
     result.flipped_after = current.flipped;
+  }
+  // Kept when it removes flips or lowers ε_angle, its aim; otherwise the input is returned.
+  result.eps_angle_before = map_distortion(P, map.polycube_on_model_xyz).eps_angle;
+  result.eps_angle_after = map_distortion(P, result.polycube_on_model_xyz).eps_angle;
+  if (!(result.flipped_after[0] + result.flipped_after[1] < result.flipped_before[0] + result.flipped_before[1] ||
+        result.eps_angle_after < result.eps_angle_before)) {
+    result.kept = false;
+    result.polycube_on_model = map.polycube_on_model;
+    result.model_on_polycube = map.model_on_polycube;
+    result.polycube_on_model_xyz = map.polycube_on_model_xyz;
+    result.model_on_polycube_xyz = map.model_on_polycube_xyz;
+    result.flipped_after = result.flipped_before;
   }
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return result;

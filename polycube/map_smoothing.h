@@ -113,6 +113,11 @@ struct MapSmoothingOptions {
 //   relocated              model vertices whose φ⁻¹ was recomputed in the returned map
 //   flipped_before/after   {P → M, M → P} flipped or degenerate image triangles, as audit_map
 //                          counts them, of the input and of the returned map (after <= before)
+//   kept                   the smoothed map is returned: it has fewer flipped triangles (both
+//                          directions together) or a lower ε_angle than the input; otherwise the
+//                          input is (a map already near-conformal, whose P matches the model face
+//                          for face, only loses by relaxation: images leave the model's corners)
+//   eps_angle_before/after ε_angle of the input's and the smoothed map's P → M samples
 //   seconds                wall time
 struct MapSmoothingResult {
   std::vector<SurfacePoint> polycube_on_model;
@@ -129,6 +134,8 @@ struct MapSmoothingResult {
   int untangle_sweeps = 0;
   int untangle_moves = 0;
   std::array<int, 2> flipped_before{0, 0}, flipped_after{0, 0};
+  bool kept = true;
+  double eps_angle_before = 1, eps_angle_after = 1;
   double seconds = 0;
 };
 

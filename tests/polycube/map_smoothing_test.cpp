@@ -126,6 +126,27 @@ TEST(MapSmoothing, NoSweepsReturnsTheInput) {
   EXPECT_EQ(r.flipped_after, r.flipped_before);
 }
 
+// A map that is already conformal is returned as it is: CGAL's corner.off (an L-shaped block) has a
+// polycube that is the block itself and an unsmoothed map of ε_angle 1.0001, which relaxation
+// would pull off the block's corners. The sphere's map is smoothed and kept.
+TEST(MapSmoothing, KeptOnlyWhenItRemovesFlipsOrLowersTheAngleDistortion) {
+  const Pipeline& corner = pipeline("corner.off");
+  const MapSmoothingResult r = smooth_map(corner.model, corner.polycube.polycube, corner.map);
+  EXPECT_FALSE(r.kept);
+  EXPECT_LT(r.eps_angle_before, 1.001);
+  EXPECT_GE(r.eps_angle_after, r.eps_angle_before);
+  EXPECT_GT(r.moves, 0);  // it did move, and was not kept
+  EXPECT_EQ(r.polycube_on_model_xyz, corner.map.polycube_on_model_xyz);
+  EXPECT_EQ(r.model_on_polycube_xyz, corner.map.model_on_polycube_xyz);
+  EXPECT_EQ(r.flipped_after, r.flipped_before);
+
+  const Pipeline& sphere = pipeline("sphere.off");
+  const MapSmoothingResult s = smooth_map(sphere.model, sphere.polycube.polycube, sphere.map);
+  EXPECT_TRUE(s.kept);
+  EXPECT_LT(s.eps_angle_after, s.eps_angle_before);
+  EXPECT_NE(s.polycube_on_model_xyz, sphere.map.polycube_on_model_xyz);
+}
+
 // More sweeps, smoother: the angle distortion keeps falling while the flips stay within bounds.
 TEST(MapSmoothing, MoreSweepsLowerAngleDistortionFurther) {
   const Pipeline& p = pipeline("rocker-arm.obj");
