@@ -59,7 +59,9 @@ def run_command(command, mesh, report_path):
     if proc.returncode == 0:
         with open(report_path) as f:
             report = json.load(f)
-    error = "" if proc.returncode == 0 else (lines[-2] if len(lines) >= 2 else "exit %d" % proc.returncode)
+    # The one-line error; /usr/bin/time's own lines come after it.
+    errors = [l for l in lines if l.startswith("polycube: error:")]
+    error = "" if proc.returncode == 0 else (errors[-1] if errors else "exit %d" % proc.returncode)
     return proc.returncode, report, wall, rss_mb, error
 
 

@@ -214,8 +214,6 @@ std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<dou
   out->on_polycube_xyz = sampled.model_on_polycube_xyz;
   if (options.smooth_sweeps > 0) {
     progress.stage("smooth", "harmonic relaxation of the images on the model, flips guarded");
-    // smooth_map audits its input itself (flipped_before); the distortion before is cheap.
-    const DistortionStats before = map_distortion(P.mesh, out->on_model_xyz);
     MapSmoothingOptions smooth_options;
     smooth_options.sweeps = options.smooth_sweeps;
     // Returns its input when it neither removes flips nor lowers ε_angle (smoothed.kept).
@@ -223,8 +221,9 @@ std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<dou
     out->on_model_xyz = smoothed.polycube_on_model_xyz;
     out->on_polycube_xyz = smoothed.model_on_polycube_xyz;
     out->smooth_seconds = smoothed.seconds;
+    const DistortionStats& before = smoothed.distortion_before;
     out->smoothing = {{"kept", smoothed.kept},
-                      {"eps_angle_after", smoothed.eps_angle_after},
+                      {"eps_angle_after", smoothed.distortion_after.eps_angle},
                       {"sweeps", smoothed.sweeps},
                       {"rounds", smoothed.rounds},
                       {"moves", smoothed.moves},
@@ -241,8 +240,8 @@ std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<dou
     progress.stage("smooth", std::to_string(smoothed.flipped_before[0]) + " / " + std::to_string(smoothed.flipped_before[1]) +
                                  " flipped before, " + std::to_string(smoothed.flipped_after[0]) + " / " +
                                  std::to_string(smoothed.flipped_after[1]) + " after" +
-                                 (smoothed.kept ? "" : "; not kept (eps_angle " + std::to_string(smoothed.eps_angle_before) + " -> " +
-                                                           std::to_string(smoothed.eps_angle_after) + ")"));
+                                 (smoothed.kept ? "" : "; not kept (eps_angle " + std::to_string(before.eps_angle) + " -> " +
+                                                           std::to_string(smoothed.distortion_after.eps_angle) + ")"));
     if (options.refine) {
       progress.stage("refine", "again where the smoothed map's chords flip or lose area");
       PolycubeMap samples;

@@ -144,7 +144,7 @@ MapRefinementResult refine_map_sampling(const TriMesh& model, const PolycubeResu
 // on that model edge. Halves that still cross are split again in later rounds, so chords come to
 // lie in one closed model face each, where they lose nothing: on a CAD part's sharp edges the
 // midpoint bisections gain area only in proportion to their count (a tetrahedron's smoothed map:
-// 0.85 → 0.87 with 10 000 more vertices; with the edge splits 0.98 with 200).
+// 0.85 → 0.87 with 10 000 more vertices; with the edge splits 0.99 with 224, in the input frame).
 //   polycube  the P the samples belong to (e.g. refine_map_sampling's refined P)
 //   planes_z  heights new vertices are put on where edges cross them (PolycubeResult::planes_z)
 //   samples   polycube_on_model(_xyz), model_on_polycube(_xyz) at that P's vertices

@@ -2,7 +2,6 @@
 
 #include "polycube/closest_point.h"
 #include "polycube/image_orientation.h"
-#include "polycube/map_quality.h"
 
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
@@ -1236,10 +1235,10 @@ MapSmoothingResult smooth_map(const TriMesh& model, const Polycube& polycube, co
     result.flipped_after = current.flipped;
   }
   // Kept when it removes flips or lowers ε_angle, its aim; otherwise the input is returned.
-  result.eps_angle_before = map_distortion(P, map.polycube_on_model_xyz).eps_angle;
-  result.eps_angle_after = map_distortion(P, result.polycube_on_model_xyz).eps_angle;
+  result.distortion_before = map_distortion(P, map.polycube_on_model_xyz);
+  result.distortion_after = map_distortion(P, result.polycube_on_model_xyz);
   if (!(result.flipped_after[0] + result.flipped_after[1] < result.flipped_before[0] + result.flipped_before[1] ||
-        result.eps_angle_after < result.eps_angle_before)) {
+        result.distortion_after.eps_angle < result.distortion_before.eps_angle)) {
     result.kept = false;
     result.polycube_on_model = map.polycube_on_model;
     result.model_on_polycube = map.model_on_polycube;

@@ -72,6 +72,7 @@
 // (they stay frozen as the input had them), or lower the distortion that P's corners force.
 #pragma once
 
+#include "polycube/map_quality.h"
 #include "polycube/polycube_map.h"
 #include "polycube/polycube_surface.h"
 
@@ -117,7 +118,8 @@ struct MapSmoothingOptions {
 //                          directions together) or a lower ε_angle than the input; otherwise the
 //                          input is (a map already near-conformal, whose P matches the model face
 //                          for face, only loses by relaxation: images leave the model's corners)
-//   eps_angle_before/after ε_angle of the input's and the smoothed map's P → M samples
+//   distortion_before/after  map_distortion of the input's and the smoothed map's P → M samples
+//                          (after: the smoothed map's even when it is not kept)
 //   seconds                wall time
 struct MapSmoothingResult {
   std::vector<SurfacePoint> polycube_on_model;
@@ -135,7 +137,7 @@ struct MapSmoothingResult {
   int untangle_moves = 0;
   std::array<int, 2> flipped_before{0, 0}, flipped_after{0, 0};
   bool kept = true;
-  double eps_angle_before = 1, eps_angle_after = 1;
+  DistortionStats distortion_before, distortion_after;
   double seconds = 0;
 };
 

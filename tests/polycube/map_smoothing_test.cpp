@@ -133,8 +133,8 @@ TEST(MapSmoothing, KeptOnlyWhenItRemovesFlipsOrLowersTheAngleDistortion) {
   const Pipeline& corner = pipeline("corner.off");
   const MapSmoothingResult r = smooth_map(corner.model, corner.polycube.polycube, corner.map);
   EXPECT_FALSE(r.kept);
-  EXPECT_LT(r.eps_angle_before, 1.001);
-  EXPECT_GE(r.eps_angle_after, r.eps_angle_before);
+  EXPECT_LT(r.distortion_before.eps_angle, 1.001);
+  EXPECT_GE(r.distortion_after.eps_angle, r.distortion_before.eps_angle);
   EXPECT_GT(r.moves, 0);  // it did move, and was not kept
   EXPECT_EQ(r.polycube_on_model_xyz, corner.map.polycube_on_model_xyz);
   EXPECT_EQ(r.model_on_polycube_xyz, corner.map.model_on_polycube_xyz);
@@ -143,7 +143,7 @@ TEST(MapSmoothing, KeptOnlyWhenItRemovesFlipsOrLowersTheAngleDistortion) {
   const Pipeline& sphere = pipeline("sphere.off");
   const MapSmoothingResult s = smooth_map(sphere.model, sphere.polycube.polycube, sphere.map);
   EXPECT_TRUE(s.kept);
-  EXPECT_LT(s.eps_angle_after, s.eps_angle_before);
+  EXPECT_LT(s.distortion_after.eps_angle, s.distortion_before.eps_angle);
   EXPECT_NE(s.polycube_on_model_xyz, sphere.map.polycube_on_model_xyz);
 }
 
