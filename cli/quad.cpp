@@ -40,6 +40,8 @@ struct QuadCommandOptions {
   int refine = 3;
   double refine_target = 0.25;
   double refine_growth = 1.3;
+  double refine_bound = 0.5;
+  double refine_bound_growth = 3;
   bool fit = true;
   std::string report_path;
   std::string preview_path;
@@ -182,6 +184,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   report["parameters"] = {{"target_faces", options.cell_size > 0 ? nlohmann::json() : nlohmann::json(options.target_faces)},
                           {"cell_size", options.cell_size > 0 ? nlohmann::json(options.cell_size) : nlohmann::json()},
                           {"smooth", options.smooth},
+                          {"refine", options.refine},
+                          {"refine_target", options.refine_target},
+                          {"refine_growth", options.refine_growth},
+                          {"refine_bound", options.refine_bound},
+                          {"refine_bound_growth", options.refine_bound_growth},
                           {"map", options.map_dir.empty() ? nlohmann::json() : nlohmann::json(options.map_dir)}};
   nlohmann::json seconds = {{"read", progress.elapsed_seconds()}};
 
@@ -196,6 +203,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   remesh.refine.rounds = options.refine;
   remesh.refine.target_percent = options.refine_target;
   remesh.refine.max_growth = options.refine_growth;
+  remesh.refine.bound_percent = options.refine_bound;
+  remesh.refine.bound_growth = options.refine_bound_growth;
   remesh.carry.threads = 0;  // both maps only read; interpolation and closest points are thread-safe
   remesh.refine.threads = remesh.carry.threads;
   if (!options.fit) remesh.fit.passes = 0;
@@ -420,6 +429,15 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
       ->check(CLI::Range(1e-3, 100.0));
   command->add_option("--refine-growth", options->refine_growth,
                       "The refinement adds at most this factor of quads (1.3: up to 30 % more than the uniform grid)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 100.0));
+  command->add_option("--refine-bound", options->refine_bound,
+                      "While the quads still miss the model by more than this % of the diagonal, the refinement goes on past "
+                      "--refine and --refine-growth (up to 4 more rounds, up to --refine-bound-growth times the quads; 0: never)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
+  command->add_option("--refine-bound-growth", options->refine_bound_growth,
+                      "The most quads the refinement may add to meet --refine-bound, as a factor of the uniform grid's")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
   command->add_flag("--no-fit{false}", options->fit,

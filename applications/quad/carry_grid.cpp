@@ -2,7 +2,11 @@
 
 #include "polycube/errors.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <array>
+#include <map>
 #include <atomic>
 #include <exception>
 #include <mutex>
@@ -61,6 +65,58 @@ SurfaceMap vertex_image_map(const TriMesh& polycube, const Eigen::MatrixX3d& ima
     return p.bary[0] * images.row(F(p.face, 0)).transpose() + p.bary[1] * images.row(F(p.face, 1)).transpose() +
            p.bary[2] * images.row(F(p.face, 2)).transpose();
   };
+}
+
+SurfaceMap finished_grid_map(const TriMesh& polycube, const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model) {
+  if (quads.Q != grid.mesh.Q) throw std::invalid_argument("the finished quads do not have the grid's connectivity");
+  auto on_polycube = std::make_shared<const SurfaceProjector>(triangulate_quads(grid.mesh));
+  return [&polycube, &model, on_polycube, V = quads.V](const SurfacePoint& p) -> Eigen::Vector3d {
+    const Eigen::Vector3d x = surface_position(polycube, p);
+    const SurfaceHit hit = on_polycube->closest(x);
+    const TriMesh& t = on_polycube->surface();
+    const Eigen::Vector3d a = t.V.row(t.F(hit.face, 0)), b = t.V.row(t.F(hit.face, 1)), c = t.V.row(t.F(hit.face, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    const double area = n.squaredNorm();
+    Eigen::Vector3d bary = Eigen::Vector3d::Unit(0);
+    if (area > 0) {
+      bary = {std::max(0.0, (c - b).cross(hit.point - b).dot(n) / area), std::max(0.0, (a - c).cross(hit.point - c).dot(n) / area),
+              std::max(0.0, (b - a).cross(hit.point - a).dot(n) / area)};
+      bary /= bary.sum();
+    }
+    const Eigen::Vector3d y = bary[0] * V.row(t.F(hit.face, 0)).transpose() + bary[1] * V.row(t.F(hit.face, 1)).transpose() +
+                              bary[2] * V.row(t.F(hit.face, 2)).transpose();
+    return model.closest(y).point;
+  };
+}
+
+std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid& to) {
+  std::vector<int> same(to.mesh.num_vertices(), -1);
+  if (from.mesh.num_vertices() == 0) return same;
+  const Eigen::Vector3d low = from.mesh.V.colwise().minCoeff(), high = from.mesh.V.colwise().maxCoeff();
+  const double tolerance = 1e-9 * std::max((high - low).norm(), 1e-300);
+  // Buckets of twice the tolerance: a point's match is in its bucket or a neighbouring one.
+  const auto key = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3d k = ((x - low) / (2 * tolerance)).array().floor();
+    return std::array<long long, 3>{static_cast<long long>(k.x()), static_cast<long long>(k.y()), static_cast<long long>(k.z())};
+  };
+  std::map<std::array<long long, 3>, std::vector<int>> buckets;
+  for (int v = 0; v < from.mesh.num_vertices(); ++v) buckets[key(from.mesh.V.row(v).transpose())].push_back(v);
+  for (int v = 0; v < to.mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d x = to.mesh.V.row(v);
+    const auto k = key(x);
+    for (int i = -1; i <= 1 && same[v] < 0; ++i)
+      for (int j = -1; j <= 1 && same[v] < 0; ++j)
+        for (int l = -1; l <= 1 && same[v] < 0; ++l) {
+          const auto found = buckets.find({k[0] + i, k[1] + j, k[2] + l});
+          if (found == buckets.end()) continue;
+          for (int u : found->second)
+            if ((from.mesh.V.row(u).transpose() - x).norm() <= tolerance) {
+              same[v] = u;
+              break;
+            }
+        }
+  }
+  return same;
 }
 
 SurfaceMap projected_map(SurfaceMap map, std::shared_ptr<const SurfaceProjector> surface) {

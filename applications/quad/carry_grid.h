@@ -14,6 +14,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 namespace polycube {
 
@@ -38,5 +39,18 @@ SurfaceMap vertex_image_map(const TriMesh& polycube, const Eigen::MatrixX3d& ima
 // map followed by the closest point on the projector's surface (so that images interpolated
 // between points of M land on M). Keeps the projector alive.
 SurfaceMap projected_map(SurfaceMap map, std::shared_ptr<const SurfaceProjector> surface);
+
+// The map through finished quads of a grid: a point of P located in the grid's quads on P (two
+// triangles each, as triangulate_quads splits them), the same triangle and barycentric
+// coordinates taken in `quads` (the grid carried to M and relaxed: same connectivity), then the
+// closest point of `model`. A refined grid carried by it starts where the relaxation left the
+// grid it refines. Copies what it needs of the grid and quads; `polycube` (the triangles of P the
+// surface points refer to) and `model` must outlive the map.
+SurfaceMap finished_grid_map(const TriMesh& polycube, const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model);
+
+// Per vertex of grid `to`, the vertex of grid `from` at the same point (positions on P equal to
+// 1e-9 of P's bounding-box diagonal), -1 for none: a refined grid keeps the lines of the grid it
+// refines, so their crossings are the same vertices.
+std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid& to);
 
 }  // namespace polycube

@@ -2,6 +2,7 @@
 
 #include "polycube/closest_point.h"
 #include "polycube/errors.h"
+#include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
 
 #include <algorithm>
@@ -65,35 +66,67 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
                           const PreimageLocator& locator, double distance, double cell_size, int threads) {
   const TriMesh& surface = model.surface();
   const SurfaceProjector on_quads(triangulate_quads(quads));
-  // Points of M: its vertices, then centroid and edge midpoints of its large triangles.
+  // Points of M: its vertices, then the centroids of its triangles longer than a quarter cell
+  // and points along its edges longer than that, at most a quarter cell apart (a coarse CAD
+  // mesh is missed between its vertices, along its creases); each with a vertex of M whose
+  // closest point starts its search.
   std::vector<Eigen::Vector3d> samples;
+  std::vector<int> hint_vertex;
   samples.reserve(surface.num_vertices());
   for (int v = 0; v < surface.num_vertices(); ++v) samples.push_back(surface.V.row(v).transpose());
+  const double spacing = cell_size / 4;
   for (int f = 0; f < surface.num_faces(); ++f) {
     const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)), b = surface.V.row(surface.F(f, 1)), c = surface.V.row(surface.F(f, 2));
-    if (std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}) <= cell_size / 4) continue;
+    if (std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}) <= spacing) continue;
     samples.push_back((a + b + c) / 3);
-    samples.push_back((a + b) / 2);
-    samples.push_back((b + c) / 2);
-    samples.push_back((c + a) / 2);
+    hint_vertex.push_back(surface.F(f, 0));
   }
-  const int ns = static_cast<int>(samples.size()), nq = quads.num_quads();
+  const EdgeMap edges = build_edge_map(surface.F);
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    const Eigen::Vector3d a = surface.V.row(edges.E(e, 0)), b = surface.V.row(edges.E(e, 1));
+    const int parts = static_cast<int>(std::ceil((b - a).norm() / spacing));
+    for (int k = 1; k < parts; ++k) {
+      samples.push_back(a + (b - a) * (static_cast<double>(k) / parts));
+      hint_vertex.push_back(edges.E(e, 0));
+    }
+  }
+  // Points of the quads, on M and on P: centres, and midpoints of edges (each once).
+  std::vector<Eigen::Vector3d> quad_points, quad_points_on_p;
+  for (int q = 0; q < quads.num_quads(); ++q) {
+    Eigen::Vector3d on_model = Eigen::Vector3d::Zero(), on_p = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 4; ++i) {
+      on_model += quads.V.row(quads.Q(q, i)).transpose() / 4;
+      on_p += grid.mesh.V.row(grid.mesh.Q(q, i)).transpose() / 4;
+    }
+    quad_points.push_back(on_model);
+    quad_points_on_p.push_back(on_p);
+    for (int i = 0; i < 4; ++i) {
+      const int u = quads.Q(q, i), w = quads.Q(q, (i + 1) % 4);
+      if (u > w) continue;
+      quad_points.push_back((quads.V.row(u) + quads.V.row(w)).transpose() / 2);
+      quad_points_on_p.push_back((grid.mesh.V.row(u) + grid.mesh.V.row(w)).transpose() / 2);
+    }
+  }
+  const int nv = surface.num_vertices(), ns = static_cast<int>(samples.size()), nq = static_cast<int>(quad_points.size());
   // Per candidate: its distance and its point of P (set when a miss).
   std::vector<double> miss(ns + nq, 0);
   std::vector<SurfacePoint> where(ns + nq);
+  // The model's points first on the quads' sheet, walking from a neighbour's closest point (the
+  // vertices in breadth-first order): a walk's distance is never below the true one, so only the
+  // points it leaves beyond `distance` need the whole search (most need none: a walk is many
+  // times faster).
+  std::vector<SurfaceHit> near = closest_to_vertices(on_quads, surface, true);
+  near.resize(ns);
+  for (int k = nv; k < ns; ++k) near[k] = on_quads.closest_on_sheet(samples[k], near[hint_vertex[k - nv]]);
   parallel_range(ns + nq, threads, [&](int k) {
     if (k < ns) {
-      miss[k] = on_quads.closest(samples[k]).distance;
+      miss[k] = near[k].distance;
+      if (miss[k] <= distance) return;
+      miss[k] = on_quads.closest(samples[k], near[k]).distance;
       if (miss[k] > distance) where[k] = locator.preimage(samples[k]);
     } else {
-      const int q = k - ns;
-      Eigen::Vector3d on_model = Eigen::Vector3d::Zero(), on_p = Eigen::Vector3d::Zero();
-      for (int i = 0; i < 4; ++i) {
-        on_model += quads.V.row(quads.Q(q, i)).transpose() / 4;
-        on_p += grid.mesh.V.row(grid.mesh.Q(q, i)).transpose() / 4;
-      }
-      miss[k] = model.closest(on_model).distance;
-      if (miss[k] > distance) where[k] = locator.on_polycube(on_p);
+      miss[k] = model.closest(quad_points[k - ns]).distance;
+      if (miss[k] > distance) where[k] = locator.on_polycube(quad_points_on_p[k - ns]);
     }
   });
   QuadMiss result;

@@ -32,6 +32,17 @@ struct QuadRefineOptions {
   // At most this times the unrefined grid's quads; a round that would exceed it is retried with
   // the worse half of its places (down to one), then refinement stops.
   double max_growth = 1.3;
+  // The bound the result must meet, in % of the diagonal (issue 7: 0.5): while the quads miss the
+  // model by more than this when the rounds or the budget above are spent, the refinement goes on
+  // for up to bound_rounds more rounds with a budget of bound_growth times the unrefined grid's
+  // quads. 0: no bound.
+  double bound_percent = 0.5;
+  double bound_growth = 3;
+  int bound_rounds = 4;
+  // A round's grid is carried through the quads it refines (finished_grid_map: its vertices start
+  // where the last relaxation left them) and relaxed with at most this many sweeps; 0: carried
+  // by the map and relaxed with all the sweeps, as the first pass.
+  int warm_sweeps = 15;
   // Threads for the distance queries and the map's values at P's vertices (the map must then be
   // thread-safe); 0: one per hardware thread, 1: the calling thread.
   int threads = 1;
@@ -57,12 +68,15 @@ class PreimageLocator {
 // Where quads on M (the grid carried, perhaps relaxed: same connectivity) miss M by more than
 // `distance`:
 //   points    points of P to refine at, the worst first: the preimages of the points of M
-//             farther than `distance` from the quads (two triangles each) — M's vertices, and the
-//             centroids and edge midpoints of M's triangles longer than cell_size / 4 (a coarse
-//             CAD mesh is missed inside its triangles) — and the centres on P of quads whose
-//             centre on M is farther than `distance` from M
+//             farther than `distance` from the quads (two triangles each) — M's vertices, the
+//             centroids of its triangles longer than cell_size / 4 and points along its edges
+//             longer than that, at most cell_size / 4 apart (a coarse CAD mesh is missed between
+//             its vertices, along its creases) — and the points on P of quad centres and quad edge
+//             midpoints farther than `distance` from M (quads bridging a concave crease)
 //   distances their distances
-//   farthest  the largest of both distances (whether or not above `distance`)
+//   farthest  the largest of both distances: exact when above `distance`; when every point is
+//             within it, perhaps a little over the true largest (a point of M may be measured by
+//             a walk on the quads' sheet, which never comes out nearer than the closest point)
 struct QuadMiss {
   std::vector<SurfacePoint> points;
   std::vector<double> distances;  // per point, descending

@@ -9,8 +9,13 @@
 //                                               then relaxed again around them (pinned)
 //   repeat: find_quad_misses(grid, quads, M)    optional: where the finished quads miss M, taken
 //           grid = build_polycube_grid(+ those) back to P; the chord parts there halved; the
-//           carry, smooth, fit again            grid carried, relaxed and fitted again; kept when
-//                                               it misses less and flips nothing more
+//           carry through the last quads,       grid carried through the last round's quads
+//           smooth, fit                         (finished_grid_map; their fitted corners kept
+//                                               where no line was added), relaxed with fewer
+//                                               sweeps, fitted; the round that misses least
+//                                               without flipping more is kept; past the rounds
+//                                               and budget asked for, more of both while beyond
+//                                               the bound (QuadRefineOptions)
 //   quality = measure_quads(quads, M, corners)
 #pragma once
 

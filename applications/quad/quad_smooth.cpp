@@ -347,13 +347,17 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   std::vector<SurfaceHit> start_vertex_hit, start_quad_hit, checked_hit(mesh.num_quads());
   std::vector<int> start_quad_state, checked_state(mesh.num_quads()), all_quads(mesh.num_quads());
   std::iota(all_quads.begin(), all_quads.end(), 0);
+  const int check_every = std::max(1, options.check_every);
+  int since_check = 0;
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     ++result.sweeps;
     size = mean_quad_size(mesh);
-    start_V = mesh.V;
-    start_vertex_hit = vertex_hit;
-    start_quad_hit = quad_hit;
-    start_quad_state = quad_state;
+    if (since_check == 0) {
+      start_V = mesh.V;
+      start_vertex_hit = vertex_hit;
+      start_quad_hit = quad_hit;
+      start_quad_state = quad_state;
+    }
     mark_trouble();
     std::vector<Tally> tally(threads);
     for (const std::vector<int>& colour : colours) {
@@ -375,42 +379,6 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
         parallel_for_each(parts, threads, "part", run);
       }
     }
-    // The end of the sweep: every quad judged against the whole surface, as measure_quads judges
-    // it (a quad across a thin part can be nearer the far sheet than its own). Where a quad lost
-    // a bit it had at the sweep's start, its moved corners go back to their start; the quads
-    // round them are judged again, until none lost one. Quads whose corners are all back have
-    // their start state again, so this ends, at worst with the sweep's start.
-    const auto judge = [&](int q) {
-      checked_hit[q] = start_quad_hit[q];
-      checked_state[q] = guard.state(q, checked_hit[q], size);
-    };
-    parallel_for_each(all_quads, threads, "quad", judge);
-    std::vector<int> lost;
-    for (int q = 0; q < mesh.num_quads(); ++q)
-      if (start_quad_state[q] & ~checked_state[q]) lost.push_back(q);
-    while (!lost.empty()) {
-      std::vector<int> again;
-      for (int q : lost)
-        for (int k = 0; k < 4; ++k) {
-          const int v = mesh.Q(q, k);
-          if (mesh.V.row(v) == start_V.row(v)) continue;
-          mesh.V.row(v) = start_V.row(v);
-          vertex_hit[v] = start_vertex_hit[v];
-          ++result.reverted;
-          for (int r : around[v]) again.push_back(r);
-        }
-      std::sort(again.begin(), again.end());
-      again.erase(std::unique(again.begin(), again.end()), again.end());
-      lost.clear();
-      for (int q : again) {
-        judge(q);
-        if (start_quad_state[q] & ~checked_state[q]) lost.push_back(q);
-      }
-    }
-    for (int q = 0; q < mesh.num_quads(); ++q) {
-      quad_state[q] = checked_state[q];
-      quad_hit[q] = checked_hit[q];
-    }
     double largest = 0;
     for (const Tally& t : tally) {
       result.moves += t.moves;
@@ -418,7 +386,48 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
       largest = std::max(largest, t.largest);
     }
     result.largest_move = size > 0 ? largest / size : 0;
-    if (result.largest_move <= options.tolerance) {
+    const bool converged = result.largest_move <= options.tolerance;
+    if (++since_check == check_every || converged || sweep + 1 == options.sweeps) {
+      since_check = 0;
+      // The check, every check_every sweeps and after the last: every quad judged against the
+      // whole surface, as measure_quads judges it (a quad across a thin part can be nearer the far
+      // sheet than its own). Where a quad lost a bit it had at the last check, its moved corners
+      // go back to where they were then; the quads round them are judged again, until none lost
+      // one. Quads whose corners are all back have their state of then again, so this ends, at
+      // worst where the last check left the quads.
+      const auto judge = [&](int q) {
+        checked_hit[q] = start_quad_hit[q];
+        checked_state[q] = guard.state(q, checked_hit[q], size);
+      };
+      parallel_for_each(all_quads, threads, "quad", judge);
+      std::vector<int> lost;
+      for (int q = 0; q < mesh.num_quads(); ++q)
+        if (start_quad_state[q] & ~checked_state[q]) lost.push_back(q);
+      while (!lost.empty()) {
+        std::vector<int> again;
+        for (int q : lost)
+          for (int k = 0; k < 4; ++k) {
+            const int v = mesh.Q(q, k);
+            if (mesh.V.row(v) == start_V.row(v)) continue;
+            mesh.V.row(v) = start_V.row(v);
+            vertex_hit[v] = start_vertex_hit[v];
+            ++result.reverted;
+            for (int r : around[v]) again.push_back(r);
+          }
+        std::sort(again.begin(), again.end());
+        again.erase(std::unique(again.begin(), again.end()), again.end());
+        lost.clear();
+        for (int q : again) {
+          judge(q);
+          if (start_quad_state[q] & ~checked_state[q]) lost.push_back(q);
+        }
+      }
+      for (int q = 0; q < mesh.num_quads(); ++q) {
+        quad_state[q] = checked_state[q];
+        quad_hit[q] = checked_hit[q];
+      }
+    }
+    if (converged) {
       result.converged = true;
       break;
     }
@@ -427,7 +436,8 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   return result;
 }
 
-QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options) {
+QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options,
+                        const std::vector<char>& pinned) {
   const auto start = std::chrono::steady_clock::now();
   if (options.passes < 0) throw std::invalid_argument("fitting passes must be >= 0, got " + std::to_string(options.passes));
   if (!(options.tolerance >= 0) || !(options.reach > 0) || !(options.max_corner_deviation >= 0))
@@ -438,7 +448,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   result.mesh = quads;
   QuadMesh& mesh = result.mesh;
   const int nv = mesh.num_vertices();
-  result.pinned.assign(nv, 0);
+  if (!pinned.empty() && static_cast<int>(pinned.size()) != nv)
+    throw std::invalid_argument("fitting: " + std::to_string(pinned.size()) + " pinned flags for " + std::to_string(nv) + " vertices");
+  result.pinned = pinned.empty() ? std::vector<char>(nv, 0) : pinned;
   if (mesh.num_quads() == 0 || options.passes == 0) return result;
   const TriMesh& model = surface.surface();
   const double tolerance = options.tolerance * bounding_box(model.V).diagonal();
@@ -458,8 +470,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   auto measure_all = [&]() {
     const SurfaceProjector triangles(triangulate_quads(mesh));
     for (auto& list : owned) list.clear();
+    const std::vector<SurfaceHit> hits = closest_to_vertices(triangles, model, false);
     for (int w = 0; w < model.num_vertices(); ++w) {
-      const SurfaceHit hit = triangles.closest(model.V.row(w).transpose());
+      const SurfaceHit& hit = hits[w];
       distance[w] = hit.distance;
       owner[w] = hit.face / 2;
       owned[owner[w]].push_back(w);

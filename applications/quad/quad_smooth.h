@@ -40,6 +40,10 @@ struct QuadSmoothOptions {
   // Worker threads (vertices sharing no quad move in parallel); 0: one per hardware thread. The
   // result does not depend on it.
   int threads = 0;
+  // The moves are judged against the whole surface (see smooth_quads) after every this many
+  // sweeps and after the last; 1: after every sweep. Between checks the moves are judged on the
+  // quads' own sheets; a quad that lost a bit sends its corners back to the last check.
+  int check_every = 4;
 };
 
 // What happened.
@@ -119,7 +123,11 @@ struct QuadFitResult {
   double seconds = 0;
 };
 
-// Throws std::invalid_argument for negative passes, tolerance or max_corner_deviation, or reach <= 0.
-QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options = {});
+// pinned (empty, or one flag per vertex): vertices already fitted (a refinement round's, from the
+// quads it refines), not moved and pinned in the result.
+// Throws std::invalid_argument for negative passes, tolerance or max_corner_deviation, reach <= 0,
+// or pinned flags of the wrong size.
+QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options = {},
+                        const std::vector<char>& pinned = {});
 
 }  // namespace polycube

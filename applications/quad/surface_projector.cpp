@@ -107,9 +107,13 @@ SurfaceHit SurfaceProjector::closest(const Eigen::Vector3d& query) const {
 
 SurfaceHit SurfaceProjector::closest(const Eigen::Vector3d& query, const SurfaceHit& hint) const {
   if (hint.face < 0 || hint.face >= impl_->surface.num_faces()) return closest(query);
+  // The tree search only visits boxes nearer than its starting point: the closest point on the
+  // hint's sheet (a short walk) is a far tighter start than the hint itself.
+  const SurfaceHit start = closest_on_sheet(query, hint);
   const Point q(query.x(), query.y(), query.z());
   const auto [point, face] =
-      impl_->tree.closest_point_and_primitive(q, {Point(hint.point.x(), hint.point.y(), hint.point.z()), hint.face});
+      impl_->tree.closest_point_and_primitive(q, {Point(start.point.x(), start.point.y(), start.point.z()), start.face});
+  if (face == start.face) return start;
   return impl_->hit(query, {point.x(), point.y(), point.z()}, face);
 }
 
@@ -181,6 +185,34 @@ SurfaceHit SurfaceProjector::Impl::hit(const Eigen::Vector3d& query, const Eigen
   const double length = hit.normal.norm();
   hit.normal = length > 1e-12 ? (hit.normal / length).eval() : normals.row(face).transpose().eval();
   return hit;
+}
+
+std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, const TriMesh& points, bool on_sheet) {
+  const int n = points.num_vertices();
+  std::vector<SurfaceHit> hits(n);
+  const CompressedLists ring = vertex_faces(points.F, n);
+  std::vector<char> seen(n, 0);
+  std::vector<int> queue;
+  queue.reserve(n);
+  for (int root = 0; root < n; ++root) {
+    if (seen[root]) continue;
+    seen[root] = 1;
+    hits[root] = surface.closest(points.V.row(root).transpose());
+    queue.assign(1, root);
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const int v = queue[head];
+      for (const int* f = ring.first(v); f != ring.last(v); ++f)
+        for (int i = 0; i < 3; ++i) {
+          const int w = points.F(*f, i);
+          if (seen[w]) continue;
+          seen[w] = 1;
+          const Eigen::Vector3d x = points.V.row(w);
+          hits[w] = on_sheet ? surface.closest_on_sheet(x, hits[v]) : surface.closest(x, hits[v]);
+          queue.push_back(w);
+        }
+    }
+  }
+  return hits;
 }
 
 const TriMesh& SurfaceProjector::surface() const { return impl_->surface; }

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <memory>
+#include <vector>
 
 namespace polycube {
 
@@ -54,5 +55,11 @@ class SurfaceProjector {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The closest points on `surface` of all of `points`' vertices, each search starting from a
+// neighbour's result (breadth-first over points' triangles): exact (the hinted search of
+// SurfaceProjector::closest, the same answers as without hints, faster) or, with on_sheet, the
+// walks of closest_on_sheet alone (never nearer than the exact answer; many times faster).
+std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, const TriMesh& points, bool on_sheet);
 
 }  // namespace polycube

@@ -246,21 +246,39 @@ TEST(QuadCarry, RemeshPipeline) {
 // radial map from the cube squeezes into a small patch of P, so uniform quads cut across it. The
 // refined grid (lines added through the horn's patch) misses it by much less, with at most the 2x
 // the quads asked for, still closed, all-quad, irregular only at the cube's 8 corners, nothing flipped.
+// A sphere with a thin horn, and the radial map onto it from a finely triangulated cube (as the
+// polycube of a map is: the preimages are found through the images of P's vertices).
+struct HornedSphere {
+  TriMesh P;
+  std::shared_ptr<const SurfaceProjector> model;
+  SurfaceMap radial;
+};
+
+const HornedSphere& horned_sphere() {
+  static const HornedSphere result = [] {
+    TriMesh horned = test::make_sphere(5);
+    const Eigen::Vector3d axis = Eigen::Vector3d(0.3, 0.45, 0.84).normalized();
+    for (int v = 0; v < horned.num_vertices(); ++v) {
+      const Eigen::Vector3d d = horned.V.row(v).normalized();
+      const double angle = std::acos(std::clamp(d.dot(axis), -1.0, 1.0));
+      horned.V.row(v) = (1 + 0.35 * std::exp(-std::pow(angle / 0.2, 2))) * d;
+    }
+    HornedSphere h;
+    h.model = std::make_shared<const SurfaceProjector>(horned);
+    PolycubeGridOptions fine;
+    fine.target_quads = 6 * 40 * 40;
+    h.P = triangulate_quads(build_polycube_grid(cube(), fine).mesh);
+    h.radial = projected_map([P = h.P](const SurfacePoint& p) { return on_mesh(P, p).normalized().eval(); }, h.model);
+    return h;
+  }();
+  return result;
+}
+
 TEST(QuadCarry, RefinementReachesIntoAHorn) {
-  TriMesh horned = test::make_sphere(5);
-  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, 0.45, 0.84).normalized();
-  for (int v = 0; v < horned.num_vertices(); ++v) {
-    const Eigen::Vector3d d = horned.V.row(v).normalized();
-    const double angle = std::acos(std::clamp(d.dot(axis), -1.0, 1.0));
-    horned.V.row(v) = (1 + 0.35 * std::exp(-std::pow(angle / 0.2, 2))) * d;
-  }
-  const auto model = std::make_shared<const SurfaceProjector>(horned);
-  // P finely triangulated, as the polycube of a map is (the preimages are found through the
-  // images of P's vertices).
-  PolycubeGridOptions fine;
-  fine.target_quads = 6 * 40 * 40;
-  const TriMesh P = triangulate_quads(build_polycube_grid(cube(), fine).mesh);
-  const SurfaceMap radial = projected_map([P](const SurfacePoint& p) { return on_mesh(P, p).normalized().eval(); }, model);
+  const HornedSphere& h = horned_sphere();
+  const TriMesh& P = h.P;
+  const auto& model = h.model;
+  const SurfaceMap& radial = h.radial;
   QuadRemeshOptions options;
   options.grid.target_quads = 1500;
   options.smooth.sweeps = 10;
@@ -268,6 +286,7 @@ TEST(QuadCarry, RefinementReachesIntoAHorn) {
   const QuadRemeshResult uniform = remesh_quads(P, radial, *model, options);
   options.refine.rounds = 4;
   options.refine.max_growth = 2;  // lines run round the whole cube: this horn needs many
+  options.refine.bound_percent = 0;  // the rounds and budget above only (the bound: below)
   const QuadRemeshResult refined = remesh_quads(P, radial, *model, options);
 
   EXPECT_EQ(uniform.refine_rounds, 0);
@@ -287,6 +306,83 @@ TEST(QuadCarry, RefinementReachesIntoAHorn) {
   EXPECT_EQ(refined.quality.flipped_quads, 0);
   EXPECT_EQ(refined.quality.degenerate_quads, 0);
   EXPECT_LE(refined.quality.max_distance_to_surface, 1e-9 * refined.quality.diagonal);
+}
+
+// The bound: when the rounds and the budget are spent with the quads still farther from the model
+// than refine.bound_percent, the refinement goes on (more rounds, a budget of bound_growth), and
+// stops once within it.
+TEST(QuadCarry, RefinementGoesOnToTheBound) {
+  const HornedSphere& h = horned_sphere();
+  QuadRemeshOptions options;
+  options.grid.target_quads = 1500;
+  options.smooth.sweeps = 10;
+  options.refine.rounds = 1;
+  options.refine.max_growth = 1.1;
+  options.refine.bound_percent = 0;
+  const QuadRemeshResult short_budget = remesh_quads(h.P, h.radial, *h.model, options);
+  options.refine.bound_percent = 0.5;
+  options.refine.bound_growth = 3;
+  const QuadRemeshResult bounded = remesh_quads(h.P, h.radial, *h.model, options);
+  const double diagonal = bounded.quality.diagonal;
+  ASSERT_GT(short_budget.refine_miss_after, 0.005 * diagonal) << "the short budget leaves the horn beyond the bound";
+  EXPECT_GT(bounded.refine_rounds, 1) << "rounds past refine.rounds";
+  EXPECT_GT(bounded.quality.quads, short_budget.quality.quads) << "past the budget";
+  EXPECT_LE(bounded.quality.quads, 3 * 1.02 * options.grid.target_quads);
+  EXPECT_LT(bounded.refine_miss_after, short_budget.refine_miss_after);
+  EXPECT_EQ(bounded.quality.flipped_quads, 0);
+  EXPECT_EQ(bounded.quality.irregular_vertices, 8);
+  EXPECT_TRUE(bounded.quality.topology.closed_manifold());
+}
+
+// The map through a finished grid (what a refinement round carries its grid with): at the grid's
+// own vertices it gives the finished quads' vertices; elsewhere points on the model near them.
+TEST(QuadCarry, FinishedGridMapStartsWhereTheQuadsAre) {
+  const HornedSphere& h = horned_sphere();
+  QuadRemeshOptions options;
+  options.grid.target_quads = 600;
+  options.smooth.sweeps = 10;
+  options.refine.rounds = 0;
+  const QuadRemeshResult r = remesh_quads(h.P, h.radial, *h.model, options);
+  const SurfaceMap through = finished_grid_map(h.P, r.grid, r.mesh, *h.model);
+  const double diagonal = r.quality.diagonal;
+  for (int v = 0; v < r.grid.mesh.num_vertices(); ++v)
+    EXPECT_LE((through(r.grid.on_polycube[v]) - r.mesh.V.row(v).transpose()).norm(), 1e-9 * diagonal) << "vertex " << v;
+  // A finer grid carried through it: on the model, each vertex near the radial image.
+  PolycubeGridOptions finer;
+  finer.target_quads = 2400;
+  const PolycubeGrid fine = build_polycube_grid(h.P, finer);
+  const QuadMesh carried = carry_grid(fine, through);
+  for (int v = 0; v < carried.num_vertices(); ++v) {
+    const Eigen::Vector3d x = carried.V.row(v);
+    EXPECT_LE(h.model->closest(x).distance, 1e-9 * diagonal);
+    EXPECT_LE((x - h.radial(fine.on_polycube[v])).norm(), 0.1 * diagonal) << "vertex " << v;
+  }
+  QuadMesh other = r.mesh;
+  other.Q.row(0).reverseInPlace();
+  EXPECT_THROW(finished_grid_map(h.P, r.grid, other, *h.model), std::invalid_argument);
+}
+
+// A refined grid keeps the lines of the grid it refines: every vertex of the coarse grid is a vertex
+// of the refined one, found at its place; the added vertices match none.
+TEST(QuadCarry, SameGridVerticesOfARefinedGrid) {
+  const TriMesh P = cube();
+  PolycubeGridOptions options;
+  options.target_quads = 600;
+  const PolycubeGrid coarse = build_polycube_grid(P, options);
+  options.refine_rounds = {{GridRefinement{SurfacePoint{0, Eigen::Vector3d(0.21, 0.33, 0.46)}, 2}}};
+  const PolycubeGrid refined = build_polycube_grid(P, options);
+  ASSERT_GT(refined.mesh.num_vertices(), coarse.mesh.num_vertices());
+  const std::vector<int> same = same_grid_vertices(coarse, refined);
+  ASSERT_EQ(same.size(), static_cast<size_t>(refined.mesh.num_vertices()));
+  std::vector<int> found(coarse.mesh.num_vertices(), 0);
+  for (int v = 0; v < refined.mesh.num_vertices(); ++v) {
+    if (same[v] < 0) continue;
+    EXPECT_LE((refined.mesh.V.row(v) - coarse.mesh.V.row(same[v])).norm(), 1e-12);
+    ++found[same[v]];
+  }
+  EXPECT_EQ(std::count(found.begin(), found.end(), 1), coarse.mesh.num_vertices()) << "each coarse vertex once";
+  const std::vector<int> itself = same_grid_vertices(coarse, coarse);
+  for (int v = 0; v < coarse.mesh.num_vertices(); ++v) EXPECT_EQ(itself[v], v);
 }
 
 // The fit after the relaxation: a model vertex that sticks out between the quads (a spike on the
@@ -345,6 +441,15 @@ TEST(QuadCarry, FitPullsACornerOntoATip) {
     }
   }
   EXPECT_THROW(smooth_quads(fit.mesh, model, options, std::vector<char>(3, 0)), std::invalid_argument);
+  // Vertices given as fitted already (a refinement round's) are neither moved nor unpinned.
+  const QuadFitResult again = fit_quads(quads, model, {}, fit.pinned);
+  for (int v = 0; v < quads.num_vertices(); ++v) {
+    if (fit.pinned[v]) {
+      EXPECT_EQ(again.mesh.V.row(v), quads.V.row(v));
+      EXPECT_TRUE(again.pinned[v]);
+    }
+  }
+  EXPECT_THROW(fit_quads(quads, model, {}, std::vector<char>(3, 0)), std::invalid_argument);
   QuadFitOptions bad;
   bad.reach = 0;
   EXPECT_THROW(fit_quads(quads, model, bad), std::invalid_argument);

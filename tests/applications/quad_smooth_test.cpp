@@ -143,6 +143,35 @@ TEST(SurfaceProjector, WalkOnASheetMatchesTheTreeNearTheSurface) {
   }
 }
 
+TEST(SurfaceProjector, SearchFromAHintFindsWhatTheTreeFinds) {
+  // The hinted search walks on the hint's sheet first, then searches the tree from there: the same
+  // closest point as without a hint, from a hint nearby, far away, or on another sheet.
+  const TriMesh model = test::load_test_mesh("elk.off");
+  const SurfaceProjector projector(model);
+  const double diagonal = bounding_box(model.V).diagonal();
+  const SurfaceHit far_away = projector.closest(model.V.row(0).transpose());
+  int compared = 0;
+  for (int v = 0; v < model.num_vertices(); v += 5) {
+    const Eigen::Vector3d p = model.V.row(v);
+    const SurfaceHit at = projector.closest(p);
+    const Eigen::Vector3d offset(std::sin(1.3 * v), std::cos(0.7 * v), std::sin(2.1 * v + 2));
+    const Eigen::Vector3d query = p + 2e-2 * diagonal * offset.normalized();
+    const SurfaceHit tree = projector.closest(query);
+    for (const SurfaceHit& hint : {at, far_away}) {
+      const SurfaceHit hinted = projector.closest(query, hint);
+      EXPECT_NEAR(hinted.distance, tree.distance, 1e-12 * diagonal) << "vertex " << v;
+      EXPECT_NEAR(hinted.distance, (hinted.point - query).norm(), 1e-12 * diagonal);
+    }
+    ++compared;
+  }
+  EXPECT_GT(compared, 100);
+  const SurfaceProjector box(thin_box(0.01));
+  const SurfaceHit bottom = box.closest(Eigen::Vector3d(0.5, 0.5, -0.001));
+  const SurfaceHit top = box.closest(Eigen::Vector3d(0.52, 0.49, 0.009), bottom);
+  EXPECT_GT(box.face_normal(top.face).z(), 0.99) << "the nearer sheet, not the hint's";
+  EXPECT_NEAR(top.distance, 0.001, 1e-12);
+}
+
 TEST(SurfaceProjector, WalkStaysOnItsSheetOfAThinPart) {
   const SurfaceProjector box(thin_box(0.01));
   const SurfaceHit bottom = box.closest(Eigen::Vector3d(0.5, 0.5, -0.001));
