@@ -67,28 +67,6 @@ SurfaceMap vertex_image_map(const TriMesh& polycube, const Eigen::MatrixX3d& ima
   };
 }
 
-SurfaceMap finished_grid_map(const TriMesh& polycube, const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model) {
-  if (quads.Q != grid.mesh.Q) throw std::invalid_argument("the finished quads do not have the grid's connectivity");
-  auto on_polycube = std::make_shared<const SurfaceProjector>(triangulate_quads(grid.mesh));
-  return [&polycube, &model, on_polycube, V = quads.V](const SurfacePoint& p) -> Eigen::Vector3d {
-    const Eigen::Vector3d x = surface_position(polycube, p);
-    const SurfaceHit hit = on_polycube->closest(x);
-    const TriMesh& t = on_polycube->surface();
-    const Eigen::Vector3d a = t.V.row(t.F(hit.face, 0)), b = t.V.row(t.F(hit.face, 1)), c = t.V.row(t.F(hit.face, 2));
-    const Eigen::Vector3d n = (b - a).cross(c - a);
-    const double area = n.squaredNorm();
-    Eigen::Vector3d bary = Eigen::Vector3d::Unit(0);
-    if (area > 0) {
-      bary = {std::max(0.0, (c - b).cross(hit.point - b).dot(n) / area), std::max(0.0, (a - c).cross(hit.point - c).dot(n) / area),
-              std::max(0.0, (b - a).cross(hit.point - a).dot(n) / area)};
-      bary /= bary.sum();
-    }
-    const Eigen::Vector3d y = bary[0] * V.row(t.F(hit.face, 0)).transpose() + bary[1] * V.row(t.F(hit.face, 1)).transpose() +
-                              bary[2] * V.row(t.F(hit.face, 2)).transpose();
-    return model.closest(y).point;
-  };
-}
-
 std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid& to) {
   std::vector<int> same(to.mesh.num_vertices(), -1);
   if (from.mesh.num_vertices() == 0) return same;
@@ -117,6 +95,38 @@ std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid
         }
   }
   return same;
+}
+
+QuadMesh carry_refined_grid(const PolycubeGrid& grid, const SurfaceMap& map, const PolycubeGrid& from, const QuadMesh& quads,
+                            const SurfaceProjector& model, const CarryOptions& options) {
+  if (quads.Q != from.mesh.Q) throw std::invalid_argument("the finished quads do not have the refined grid's connectivity");
+  QuadMesh mesh = carry_grid(grid, map, options);
+  const std::vector<int> same = same_grid_vertices(from, grid);
+  // How far the relaxation and the fit moved each vertex of `from` from its image.
+  const Eigen::MatrixX3d moved = quads.V - carry_grid(from, map, options).V;
+  const SurfaceProjector on_from(triangulate_quads(from.mesh));
+  const TriMesh& t = on_from.surface();
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    if (same[v] >= 0) {
+      mesh.V.row(v) = quads.V.row(same[v]);
+      continue;
+    }
+    // An added vertex: its image, moved as the vertices of `from` round it were (barycentric in
+    // from's triangles on P), back on the model.
+    const SurfaceHit hit = on_from.closest(grid.mesh.V.row(v).transpose());
+    const Eigen::Vector3d a = t.V.row(t.F(hit.face, 0)), b = t.V.row(t.F(hit.face, 1)), c = t.V.row(t.F(hit.face, 2));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    Eigen::Vector3d bary(1.0 / 3, 1.0 / 3, 1.0 / 3);
+    if (n.squaredNorm() > 0) {
+      bary = {std::max(0.0, (c - b).cross(hit.point - b).dot(n)), std::max(0.0, (a - c).cross(hit.point - c).dot(n)),
+              std::max(0.0, (b - a).cross(hit.point - a).dot(n))};
+      if (bary.sum() > 0) bary /= bary.sum();
+    }
+    Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) shift += bary[i] * moved.row(t.F(hit.face, i)).transpose();
+    mesh.V.row(v) = model.closest(mesh.V.row(v).transpose() + shift).point;
+  }
+  return mesh;
 }
 
 SurfaceMap projected_map(SurfaceMap map, std::shared_ptr<const SurfaceProjector> surface) {

@@ -40,17 +40,19 @@ SurfaceMap vertex_image_map(const TriMesh& polycube, const Eigen::MatrixX3d& ima
 // between points of M land on M). Keeps the projector alive.
 SurfaceMap projected_map(SurfaceMap map, std::shared_ptr<const SurfaceProjector> surface);
 
-// The map through finished quads of a grid: a point of P located in the grid's quads on P (two
-// triangles each, as triangulate_quads splits them), the same triangle and barycentric
-// coordinates taken in `quads` (the grid carried to M and relaxed: same connectivity), then the
-// closest point of `model`. A refined grid carried by it starts where the relaxation left the
-// grid it refines. Copies what it needs of the grid and quads; `polycube` (the triangles of P the
-// surface points refer to) and `model` must outlive the map.
-SurfaceMap finished_grid_map(const TriMesh& polycube, const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model);
-
 // Per vertex of grid `to`, the vertex of grid `from` at the same point (positions on P equal to
 // 1e-9 of P's bounding-box diagonal), -1 for none: a refined grid keeps the lines of the grid it
 // refines, so their crossings are the same vertices.
 std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid& to);
+
+// A refined grid carried as its refinement round starts: the vertices it shares with the grid it
+// refines (same_grid_vertices) where that grid's finished quads have them (`quads`: carried,
+// relaxed and fitted; same connectivity as `from`); each added one at its image under the map
+// (so it reaches what the old quads cut across), shifted as the vertices of `from` round it
+// were shifted from their images (barycentric in from's quads on P, as triangulate_quads splits
+// them), then placed on `model` by closest point. Throws std::invalid_argument when quads do not
+// have from's connectivity; what carry_grid throws.
+QuadMesh carry_refined_grid(const PolycubeGrid& grid, const SurfaceMap& map, const PolycubeGrid& from, const QuadMesh& quads,
+                            const SurfaceProjector& model, const CarryOptions& options = {});
 
 }  // namespace polycube

@@ -39,9 +39,10 @@ struct QuadRefineOptions {
   double bound_percent = 0.5;
   double bound_growth = 3;
   int bound_rounds = 4;
-  // A round's grid is carried through the quads it refines (finished_grid_map: its vertices start
-  // where the last relaxation left them) and relaxed with at most this many sweeps; 0: carried
-  // by the map and relaxed with all the sweeps, as the first pass.
+  // A round's grid keeps the places the quads it refines have for the vertices it shares with
+  // them (carry_refined_grid: only the added lines are carried by the map) and is relaxed with at
+  // most this many sweeps; 0: all carried by the map and relaxed with all the sweeps, as the
+  // first pass.
   int warm_sweeps = 15;
   // Threads for the distance queries and the map's values at P's vertices (the map must then be
   // thread-safe); 0: one per hardware thread, 1: the calling thread.

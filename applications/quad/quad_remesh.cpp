@@ -50,8 +50,9 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
   }
 
   // One pass: carry the grid, relax, fit.
-  // A refinement round's pass (from: the quads it refines) starts where from's relaxation left
-  // them, with fewer sweeps (QuadRefineOptions::warm_sweeps).
+  // A refinement round's pass (from: the quads it refines) starts where from's relaxation and fit
+  // left the vertices it keeps, the added ones carried by the map (carry_refined_grid), and
+  // relaxes with fewer sweeps (QuadRefineOptions::warm_sweeps).
   const auto run_pass = [&](QuadRemeshResult& pass, bool quiet, const QuadRemeshResult* from) {
     QuadSmoothOptions smooth = options.smooth;
     const bool warm = from && options.refine.warm_sweeps > 0;
@@ -61,7 +62,8 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     };
     say("carry", std::to_string(pass.grid.mesh.num_vertices()) + " vertices through the map");
     auto begin = std::chrono::steady_clock::now();
-    pass.mesh = carry_grid(pass.grid, warm ? finished_grid_map(polycube, from->grid, from->mesh, model) : to_model, options.carry);
+    pass.mesh = warm ? carry_refined_grid(pass.grid, to_model, from->grid, from->mesh, model, options.carry)
+                     : carry_grid(pass.grid, to_model, options.carry);
     pass.seconds_carry += since(begin);
     // A round's vertices that the quads it refines had pulled onto the model's tips start there
     // and stay, unless a line was added next to them (a quad round them has a new corner): the

@@ -9,9 +9,10 @@
 //                                               then relaxed again around them (pinned)
 //   repeat: find_quad_misses(grid, quads, M)    optional: where the finished quads miss M, taken
 //           grid = build_polycube_grid(+ those) back to P; the chord parts there halved; the
-//           carry through the last quads,       grid carried through the last round's quads
-//           smooth, fit                         (finished_grid_map; their fitted corners kept
-//                                               where no line was added), relaxed with fewer
+//           carry (kept vertices where the      grid carried (carry_refined_grid: the vertices
+//           last quads have them), smooth, fit  it keeps where the last round's quads have them,
+//                                               fitted corners pinned where no line was added),
+//                                               relaxed with fewer
 //                                               sweeps, fitted; the round that misses least
 //                                               without flipping more is kept; past the rounds
 //                                               and budget asked for, more of both while beyond

@@ -334,32 +334,45 @@ TEST(QuadCarry, RefinementGoesOnToTheBound) {
   EXPECT_TRUE(bounded.quality.topology.closed_manifold());
 }
 
-// The map through a finished grid (what a refinement round carries its grid with): at the grid's
-// own vertices it gives the finished quads' vertices; elsewhere points on the model near them.
-TEST(QuadCarry, FinishedGridMapStartsWhereTheQuadsAre) {
+// A refinement round's grid: the vertices it shares with the grid it refines where the finished
+// quads have them; the added ones at their images shifted as the old vertices round them were
+// (so within twice the largest shift of their images), on the model.
+TEST(QuadCarry, RefinedGridKeepsTheFinishedPlaces) {
   const HornedSphere& h = horned_sphere();
   QuadRemeshOptions options;
   options.grid.target_quads = 600;
   options.smooth.sweeps = 10;
   options.refine.rounds = 0;
   const QuadRemeshResult r = remesh_quads(h.P, h.radial, *h.model, options);
-  const SurfaceMap through = finished_grid_map(h.P, r.grid, r.mesh, *h.model);
+  PolycubeGridOptions finer = options.grid;
+  finer.refine_rounds = {{GridRefinement{r.grid.on_polycube[0], 1}}};
+  const PolycubeGrid refined = build_polycube_grid(h.P, finer);
+  ASSERT_GT(refined.mesh.num_vertices(), r.grid.mesh.num_vertices());
+  const QuadMesh carried = carry_refined_grid(refined, h.radial, r.grid, r.mesh, *h.model);
+  const std::vector<int> same = same_grid_vertices(r.grid, refined);
+  const double largest_shift = (r.mesh.V - carry_grid(r.grid, h.radial).V).rowwise().norm().maxCoeff();
+  EXPECT_GT(largest_shift, 1e-6) << "the relaxation moved them";
   const double diagonal = r.quality.diagonal;
-  for (int v = 0; v < r.grid.mesh.num_vertices(); ++v)
-    EXPECT_LE((through(r.grid.on_polycube[v]) - r.mesh.V.row(v).transpose()).norm(), 1e-9 * diagonal) << "vertex " << v;
-  // A finer grid carried through it: on the model, each vertex near the radial image.
-  PolycubeGridOptions finer;
-  finer.target_quads = 2400;
-  const PolycubeGrid fine = build_polycube_grid(h.P, finer);
-  const QuadMesh carried = carry_grid(fine, through);
+  int kept = 0, added = 0, shifted = 0;
   for (int v = 0; v < carried.num_vertices(); ++v) {
+    if (same[v] >= 0) {
+      EXPECT_EQ(carried.V.row(v), r.mesh.V.row(same[v])) << "vertex " << v;
+      ++kept;
+      continue;
+    }
     const Eigen::Vector3d x = carried.V.row(v);
-    EXPECT_LE(h.model->closest(x).distance, 1e-9 * diagonal);
-    EXPECT_LE((x - h.radial(fine.on_polycube[v])).norm(), 0.1 * diagonal) << "vertex " << v;
+    const double from_image = (x - h.radial(refined.on_polycube[v])).norm();
+    EXPECT_LE(from_image, 2 * largest_shift + 1e-12) << "vertex " << v;
+    EXPECT_LE(h.model->closest(x).distance, 1e-9 * diagonal) << "vertex " << v;
+    shifted += from_image > 1e-9;
+    ++added;
   }
+  EXPECT_EQ(kept, r.grid.mesh.num_vertices());
+  EXPECT_GT(added, 0);
+  EXPECT_GT(shifted, 0);
   QuadMesh other = r.mesh;
   other.Q.row(0).reverseInPlace();
-  EXPECT_THROW(finished_grid_map(h.P, r.grid, other, *h.model), std::invalid_argument);
+  EXPECT_THROW(carry_refined_grid(refined, h.radial, r.grid, other, *h.model), std::invalid_argument);
 }
 
 // A refined grid keeps the lines of the grid it refines: every vertex of the coarse grid is a vertex
