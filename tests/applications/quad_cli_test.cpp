@@ -145,6 +145,8 @@ TEST(QuadCli, CleanErrors) {
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine -1").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-growth 0.5").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-target 0").code, 2);
+  EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-bound -0.1").code, 2);
+  EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-bound-growth 0.9").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --map " + quoted(dir + "/none")).code, 3);
   EXPECT_EQ(polycube_cli("quad " + quoted(test::data_path("bad/open-cube.off")) + " -o " + quoted(dir + "/q.obj")).code, 4);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/missing/q.obj")).code, 5);
