@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 namespace polycube {
 
@@ -23,6 +24,15 @@ constexpr double kExtendedWorstFraction = 0.85;
 // ... and adds at most this factor of quads (a round of gargoyle's added 13 000 to 12 000 for
 // misses of 0.51-0.60 % spread over the model; rounds of 15-20 % met the bound with about half).
 constexpr double kExtendedRoundGrowth = 1.2;
+
+// A pass's quads and what made them, into `to` (whose stage times and refinement figures stay).
+void take_pass(QuadRemeshResult& to, QuadRemeshResult pass) {
+  to.grid = std::move(pass.grid);
+  to.mesh = std::move(pass.mesh);
+  to.smoothing = std::move(pass.smoothing);
+  to.fitting = std::move(pass.fitting);
+  to.refitting = std::move(pass.refitting);
+}
 
 std::string format(const char* pattern, double a, double b = 0, double c = 0) {
   char text[160];
@@ -205,18 +215,10 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
                            std::to_string(best_bad.second) + ")");
       if (pass_bad.first > best_bad.first) break;
       // The stage times stay the first pass's (the refinement's, its passes included, is apart).
-      current.grid = std::move(pass.grid);
-      current.mesh = std::move(pass.mesh);
-      current.smoothing = std::move(pass.smoothing);
-      current.fitting = std::move(pass.fitting);
-      current.refitting = std::move(pass.refitting);
+      take_pass(current, std::move(pass));
       miss = next;
       if (next.farthest < result.refine_miss_after) {
-        result.grid = current.grid;
-        result.mesh = current.mesh;
-        result.smoothing = current.smoothing;
-        result.fitting = current.fitting;
-        result.refitting = current.refitting;
+        take_pass(result, current);
         result.refine_miss_after = next.farthest;
         result.refine_rounds = round + 1;
         best_bad = pass_bad;
