@@ -14,9 +14,10 @@ double since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The refinement's misses are measured at M's vertices (and points of its large triangles) and
-// at the quads' centres; the Hausdorff distance, on denser samples of both surfaces, comes out a
-// few % higher (gargoyle: 0.498 % against 0.506 %). The bound is aimed at with this margin.
+// The refinement's misses are measured at sample points (find_quad_misses); the Hausdorff
+// distance, on denser samples of both surfaces, can come out a few % higher (gargoyle, before
+// the misses were sampled along M's edges and the quads' edges too: 0.498 % against 0.506 %).
+// The bound is aimed at with this margin.
 constexpr double kBoundMargin = 0.9;
 // Past the rounds and budget asked for, a round refines at the misses within this fraction of the
 // farthest (and beyond the bound).

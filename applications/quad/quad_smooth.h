@@ -78,8 +78,9 @@ struct QuadSmoothResult {
 // degenerate or nearly degenerate quad) is not held, so collapsed vertices can move apart (the
 // quad's diagonal test still is).
 // Within a sweep the moves are judged against the quads' surface normals found on their own sheet
-// (fast walks); at its end every quad is judged against the whole surface, as measure_quads
-// judges it, and the moves of the sweep that lost a quad a bit there are undone (reverted).
+// (fast walks); every options.check_every sweeps and after the last, every quad is judged against
+// the whole surface, as measure_quads judges it, and the moves since the last such check that
+// lost a quad a bit there are undone (reverted).
 // pinned (empty, or one flag per vertex): vertices that do not move (fit_quads' snapped ones).
 // Throws std::invalid_argument for step outside (0, 2], negative sweeps, weights or tolerance,
 // all weights 0, or pinned flags of the wrong size.
