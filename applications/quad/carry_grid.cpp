@@ -1,8 +1,7 @@
 #include "applications/quad/carry_grid.h"
 
+#include "polycube/closest_point.h"
 #include "polycube/errors.h"
-
-#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
@@ -97,36 +96,31 @@ std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid
   return same;
 }
 
-QuadMesh carry_refined_grid(const PolycubeGrid& grid, const SurfaceMap& map, const PolycubeGrid& from, const QuadMesh& quads,
-                            const SurfaceProjector& model, const CarryOptions& options) {
+RefinedCarry carry_refined_grid(const PolycubeGrid& grid, const SurfaceMap& map, const PolycubeGrid& from, const QuadMesh& quads,
+                                const SurfaceProjector& model, const CarryOptions& options) {
   if (quads.Q != from.mesh.Q) throw std::invalid_argument("the finished quads do not have the refined grid's connectivity");
-  QuadMesh mesh = carry_grid(grid, map, options);
-  const std::vector<int> same = same_grid_vertices(from, grid);
+  RefinedCarry carried{carry_grid(grid, map, options), same_grid_vertices(from, grid)};
+  QuadMesh& mesh = carried.mesh;
   // How far the relaxation and the fit moved each vertex of `from` from its image.
   const Eigen::MatrixX3d moved = quads.V - carry_grid(from, map, options).V;
   const SurfaceProjector on_from(triangulate_quads(from.mesh));
   const TriMesh& t = on_from.surface();
   for (int v = 0; v < mesh.num_vertices(); ++v) {
-    if (same[v] >= 0) {
-      mesh.V.row(v) = quads.V.row(same[v]);
+    if (carried.same[v] >= 0) {
+      mesh.V.row(v) = quads.V.row(carried.same[v]);
       continue;
     }
     // An added vertex: its image, moved as the vertices of `from` round it were (barycentric in
     // from's triangles on P), back on the model.
-    const SurfaceHit hit = on_from.closest(grid.mesh.V.row(v).transpose());
-    const Eigen::Vector3d a = t.V.row(t.F(hit.face, 0)), b = t.V.row(t.F(hit.face, 1)), c = t.V.row(t.F(hit.face, 2));
-    const Eigen::Vector3d n = (b - a).cross(c - a);
-    Eigen::Vector3d bary(1.0 / 3, 1.0 / 3, 1.0 / 3);
-    if (n.squaredNorm() > 0) {
-      bary = {std::max(0.0, (c - b).cross(hit.point - b).dot(n)), std::max(0.0, (a - c).cross(hit.point - c).dot(n)),
-              std::max(0.0, (b - a).cross(hit.point - a).dot(n))};
-      if (bary.sum() > 0) bary /= bary.sum();
-    }
+    const Eigen::Vector3d x = grid.mesh.V.row(v);
+    const int f = on_from.closest(x).face;
+    const Eigen::Vector3d bary =
+        closest_on_triangle(x, t.V.row(t.F(f, 0)), t.V.row(t.F(f, 1)), t.V.row(t.F(f, 2))).bary;
     Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-    for (int i = 0; i < 3; ++i) shift += bary[i] * moved.row(t.F(hit.face, i)).transpose();
+    for (int i = 0; i < 3; ++i) shift += bary[i] * moved.row(t.F(f, i)).transpose();
     mesh.V.row(v) = model.closest(mesh.V.row(v).transpose() + shift).point;
   }
-  return mesh;
+  return carried;
 }
 
 SurfaceMap projected_map(SurfaceMap map, std::shared_ptr<const SurfaceProjector> surface) {

@@ -52,7 +52,13 @@ std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid
 // were shifted from their images (barycentric in from's quads on P, as triangulate_quads splits
 // them), then placed on `model` by closest point. Throws std::invalid_argument when quads do not
 // have from's connectivity; what carry_grid throws.
-QuadMesh carry_refined_grid(const PolycubeGrid& grid, const SurfaceMap& map, const PolycubeGrid& from, const QuadMesh& quads,
-                            const SurfaceProjector& model, const CarryOptions& options = {});
+//   mesh  the carried grid
+//   same  same_grid_vertices(from, grid)
+struct RefinedCarry {
+  QuadMesh mesh;
+  std::vector<int> same;
+};
+RefinedCarry carry_refined_grid(const PolycubeGrid& grid, const SurfaceMap& map, const PolycubeGrid& from, const QuadMesh& quads,
+                                const SurfaceProjector& model, const CarryOptions& options = {});
 
 }  // namespace polycube

@@ -73,8 +73,14 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     };
     say("carry", std::to_string(pass.grid.mesh.num_vertices()) + " vertices through the map");
     auto begin = std::chrono::steady_clock::now();
-    pass.mesh = warm ? carry_refined_grid(pass.grid, to_model, from->grid, from->mesh, model, options.carry)
-                     : carry_grid(pass.grid, to_model, options.carry);
+    std::vector<int> same;  // per vertex, the vertex of from's grid at its place (-1: none)
+    if (warm) {
+      RefinedCarry carried = carry_refined_grid(pass.grid, to_model, from->grid, from->mesh, model, options.carry);
+      pass.mesh = std::move(carried.mesh);
+      same = std::move(carried.same);
+    } else {
+      pass.mesh = carry_grid(pass.grid, to_model, options.carry);
+    }
     pass.seconds_carry += since(begin);
     // A round's vertices that the quads it refines had pulled onto the model's tips start there
     // and stay, unless a line was added next to them (a quad round them has a new corner): the
@@ -83,7 +89,6 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     if (warm && !from->fitting.pinned.empty()) {
       const int nv = pass.grid.mesh.num_vertices();
       fitted.assign(nv, 0);
-      const std::vector<int> same = same_grid_vertices(from->grid, pass.grid);
       for (int v = 0; v < nv; ++v) fitted[v] = same[v] >= 0 && from->fitting.pinned[same[v]];
       const Eigen::MatrixX4i& Q = pass.grid.mesh.Q;
       for (int q = 0; q < Q.rows(); ++q)

@@ -274,15 +274,21 @@ const HornedSphere& horned_sphere() {
   return result;
 }
 
+// Options for the horned sphere: `quads` asked for, 10 relaxation sweeps, `rounds` of refinement.
+QuadRemeshOptions horn_options(int quads, int rounds) {
+  QuadRemeshOptions options;
+  options.grid.target_quads = quads;
+  options.smooth.sweeps = 10;
+  options.refine.rounds = rounds;
+  return options;
+}
+
 TEST(QuadCarry, RefinementReachesIntoAHorn) {
   const HornedSphere& h = horned_sphere();
   const TriMesh& P = h.P;
   const auto& model = h.model;
   const SurfaceMap& radial = h.radial;
-  QuadRemeshOptions options;
-  options.grid.target_quads = 1500;
-  options.smooth.sweeps = 10;
-  options.refine.rounds = 0;
+  QuadRemeshOptions options = horn_options(1500, 0);
   const QuadRemeshResult uniform = remesh_quads(P, radial, *model, options);
   options.refine.rounds = 4;
   options.refine.max_growth = 2;  // lines run round the whole cube: this horn needs many
@@ -313,10 +319,7 @@ TEST(QuadCarry, RefinementReachesIntoAHorn) {
 // stops once within it.
 TEST(QuadCarry, RefinementGoesOnToTheBound) {
   const HornedSphere& h = horned_sphere();
-  QuadRemeshOptions options;
-  options.grid.target_quads = 1500;
-  options.smooth.sweeps = 10;
-  options.refine.rounds = 1;
+  QuadRemeshOptions options = horn_options(1500, 1);
   options.refine.max_growth = 1.1;
   options.refine.bound_percent = 0;
   const QuadRemeshResult short_budget = remesh_quads(h.P, h.radial, *h.model, options);
@@ -339,17 +342,16 @@ TEST(QuadCarry, RefinementGoesOnToTheBound) {
 // (so within twice the largest shift of their images), on the model.
 TEST(QuadCarry, RefinedGridKeepsTheFinishedPlaces) {
   const HornedSphere& h = horned_sphere();
-  QuadRemeshOptions options;
-  options.grid.target_quads = 600;
-  options.smooth.sweeps = 10;
-  options.refine.rounds = 0;
+  QuadRemeshOptions options = horn_options(600, 0);
   const QuadRemeshResult r = remesh_quads(h.P, h.radial, *h.model, options);
   PolycubeGridOptions finer = options.grid;
   finer.refine_rounds = {{GridRefinement{r.grid.on_polycube[0], 1}}};
   const PolycubeGrid refined = build_polycube_grid(h.P, finer);
   ASSERT_GT(refined.mesh.num_vertices(), r.grid.mesh.num_vertices());
-  const QuadMesh carried = carry_refined_grid(refined, h.radial, r.grid, r.mesh, *h.model);
+  const RefinedCarry refined_carry = carry_refined_grid(refined, h.radial, r.grid, r.mesh, *h.model);
+  const QuadMesh& carried = refined_carry.mesh;
   const std::vector<int> same = same_grid_vertices(r.grid, refined);
+  EXPECT_EQ(refined_carry.same, same);
   const double largest_shift = (r.mesh.V - carry_grid(r.grid, h.radial).V).rowwise().norm().maxCoeff();
   EXPECT_GT(largest_shift, 1e-6) << "the relaxation moved them";
   const double diagonal = r.quality.diagonal;
