@@ -35,7 +35,7 @@ def main():
     a = ap.parse_args()
     meshes = a.meshes or default_meshes()
     extra = a.extra_args.split() if a.extra_args else []
-    stage_names = ("read", "align", "topology", "polycube", "map", "grid", "carry", "smooth", "fit", "refine", "quality", "retry")
+    stage_names = ("read", "align", "topology", "polycube", "map", "grid", "carry", "smooth", "fit", "untangle", "refine", "quality", "retry")
     rows = []
     for mesh in meshes:
         name = pathlib.Path(mesh).stem

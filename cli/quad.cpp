@@ -343,6 +343,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   seconds["refine"] = result.seconds_refine;
   seconds["smooth"] = result.seconds_smooth;
   seconds["fit"] = result.seconds_fit;
+  seconds["untangle"] = result.seconds_untangle;
   seconds["quality"] = result.seconds_quality;
   seconds["total"] = progress.elapsed_seconds();
   progress.stage("done", "wrote " + options.output);
@@ -384,6 +385,9 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                          {"farthest_before", result.fitting.farthest_before},
                          {"farthest_after", result.fitting.farthest_after},
                          {"relaxation_sweeps", result.refitting.sweeps}};
+    report["untangling"] = {{"flipped_before", result.untangling.flipped_before},
+                            {"flipped_after", result.untangling.flipped_after},
+                            {"moves", result.untangling.moves}};
     report["quality"] = quality_json(q);
     report["warnings"] = warnings;
     report["seconds"] = seconds;

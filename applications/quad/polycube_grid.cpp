@@ -608,6 +608,7 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
   }
   // The slot of cell s whose sides run along axis (a + 1) % 3 (side 0 for an outward +e_a cell).
   const auto slot_along_b = [&](int s) { return 2 * s + (cells[s].sign > 0 ? 0 : 1); };
+  std::map<std::pair<int, double>, int> last_round_cuts;  // of the last round: (chord, cut) -> its point
   if (!options.refine_rounds.empty()) {
     // A chord whose width is not one interval of one axis in all its cells (not expected: the
     // sides it crosses are parallel to P's edges it crosses) keeps equal parts, which read the
@@ -633,7 +634,8 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
                                                        : std::numeric_limits<double>::infinity();
     bool full = false;
     for (const std::vector<GridRefinement>& round : options.refine_rounds) {
-      std::map<std::pair<int, double>, int> inserted;  // (chord, cut) added this round -> by which point
+      std::map<std::pair<int, double>, int>& inserted = last_round_cuts;  // (chord, cut) added this round -> by which point
+      inserted.clear();
       for (size_t n = 0; n < round.size(); ++n) {
         if (full) break;
         const SurfacePoint& point = round[n].point;
@@ -704,7 +706,7 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
   vertex_of.reserve(static_cast<size_t>(quads) + 16);
   std::vector<Eigen::Vector3d> points;
   std::vector<std::array<int, 4>> quad_list;
-  std::vector<int> axis_list, cell_list;
+  std::vector<int> axis_list, cell_list, refined_by_list;
   quad_list.reserve(static_cast<size_t>(quads));
   grid.cell_parts.resize(num_cells, 2);
   const auto vertex = [&](const Eigen::Vector3d& p) {
@@ -742,6 +744,16 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
         quad_list.push_back(q);
         axis_list.push_back(r.sign * (a + 1));
         cell_list.push_back(s);
+        int by = -1;
+        if (!last_round_cuts.empty()) {
+          const int kb = chord_of[slot_along_b(s)], kc = chord_of[slot_along_b(s) ^ 1];
+          for (const auto& [k, cut] : {std::make_pair(kb, cuts[kb][i]), std::make_pair(kb, cuts[kb][i + 1]),
+                                       std::make_pair(kc, cuts[kc][j]), std::make_pair(kc, cuts[kc][j + 1])}) {
+            const auto it = last_round_cuts.find({k, cut});
+            if (it != last_round_cuts.end()) by = std::max(by, it->second);
+          }
+        }
+        refined_by_list.push_back(by);
       }
   }
   const int nv = static_cast<int>(points.size()), nq = static_cast<int>(quad_list.size());
@@ -750,6 +762,7 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
   grid.mesh.Q.resize(nq, 4);
   grid.quad_axis.resize(nq);
   grid.quad_cell.resize(nq);
+  grid.quad_refined_by = Eigen::Map<const Eigen::VectorXi>(refined_by_list.data(), nq);
   for (int q = 0; q < nq; ++q) {
     for (int k = 0; k < 4; ++k) grid.mesh.Q(q, k) = quad_list[q][k];
     grid.quad_axis[q] = axis_list[q];

@@ -75,6 +75,8 @@ struct PolycubeGridOptions {
 //                 coordinates)
 //   quad_axis     #Q: +-1, +-2, +-3 for an outward normal along +-x, +-y, +-z
 //   quad_cell     #Q: the layout cell each quad subdivides
+//   quad_refined_by  #Q: a point of the last refinement round (index into
+//                 options.refine_rounds.back()) that cut a line bounding the quad; -1: none
 //   layout        the coarse layout on P after removing free loops (rectangles, conforming)
 //   cell_parts    #layout quads by 2: parts of the cell's sides 0 and 2 (column 0) and 1 and 3
 //                 (column 1)
@@ -100,6 +102,7 @@ struct PolycubeGrid {
   std::vector<SurfacePoint> on_polycube;
   Eigen::VectorXi quad_axis;
   Eigen::VectorXi quad_cell;
+  Eigen::VectorXi quad_refined_by;
   QuadMesh layout;
   Eigen::MatrixX2i cell_parts;
   Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();

@@ -11,10 +11,42 @@ namespace polycube {
 
 namespace {
 constexpr double kDegrees = 57.29577951308232;
+
+// Quad q's corners, the surface's normal for it and whether it is flipped or degenerate (edges
+// or area at most the given ones).
+struct QuadCheck {
+  Eigen::Vector3d p[4];
+  Eigen::Vector3d normal;
+  bool flipped = false;
+  bool degenerate = false;
+};
+QuadCheck check_quad(const QuadMesh& quads, int q, const SurfaceProjector& reference, double min_length, double min_area) {
+  QuadCheck c;
+  for (int k = 0; k < 4; ++k) c.p[k] = quads.V.row(quads.Q(q, k));
+  c.normal = quad_surface_normal(reference, c.p);
+  const Eigen::Vector3d diagonal_cross = (c.p[2] - c.p[0]).cross(c.p[3] - c.p[1]);
+  c.flipped = diagonal_cross.dot(c.normal) <= 0;
+  double shortest = INFINITY;
+  for (int k = 0; k < 4; ++k) shortest = std::min(shortest, (c.p[(k + 1) % 4] - c.p[k]).norm());
+  c.degenerate = shortest <= min_length || diagonal_cross.norm() / 2 <= min_area;
+  return c;
+}
 }  // namespace
 
 Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const Eigen::Vector3d corners[4]) {
   return quad_surface_normal(surface, surface.closest((corners[0] + corners[1] + corners[2] + corners[3]) / 4));
+}
+
+std::vector<int> bad_quads(const QuadMesh& quads, const SurfaceProjector& reference, const QuadQualityOptions& options) {
+  const double diagonal = bounding_box(reference.surface().V).diagonal();
+  const double min_length = options.degenerate_tolerance * diagonal;
+  const double min_area = min_length * diagonal;
+  std::vector<int> out;
+  for (int q = 0; q < quads.num_quads(); ++q) {
+    const QuadCheck c = check_quad(quads, q, reference, min_length, min_area);
+    if (c.flipped || c.degenerate) out.push_back(q);
+  }
+  return out;
 }
 
 QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& reference, const std::vector<int>& corners,
@@ -44,11 +76,10 @@ QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& referen
     if (r.topology.valence[v] > 0)
       r.max_distance_to_surface = std::max(r.max_distance_to_surface, reference.closest(quads.V.row(v).transpose()).distance);
   for (int q = 0; q < r.quads; ++q) {
-    Eigen::Vector3d p[4];
-    for (int k = 0; k < 4; ++k) p[k] = quads.V.row(quads.Q(q, k));
-    const Eigen::Vector3d normal = quad_surface_normal(reference, p);
-    const Eigen::Vector3d diagonal_cross = (p[2] - p[0]).cross(p[3] - p[1]);
-    if (diagonal_cross.dot(normal) <= 0) ++r.flipped_quads;
+    const QuadCheck c = check_quad(quads, q, reference, min_length, min_area);
+    const Eigen::Vector3d* p = c.p;
+    r.flipped_quads += c.flipped;
+    r.degenerate_quads += c.degenerate;
     double shortest = INFINITY, longest = 0;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d next = p[(k + 1) % 4] - p[k], previous = p[(k + 3) % 4] - p[k];
@@ -56,9 +87,8 @@ QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& referen
       longest = std::max(longest, next.norm());
       const double angle = std::atan2(next.cross(previous).norm(), next.dot(previous)) * kDegrees;
       deviation.push_back(std::abs(angle - 90));
-      if (next.cross(previous).dot(normal) <= 0) ++r.inverted_corners;
+      if (next.cross(previous).dot(c.normal) <= 0) ++r.inverted_corners;
     }
-    if (shortest <= min_length || diagonal_cross.norm() / 2 <= min_area) ++r.degenerate_quads;
     const double aspect = shortest > 0 ? longest / shortest : INFINITY;
     aspect_sum += aspect;
     r.aspect_ratio_max = std::max(r.aspect_ratio_max, aspect);

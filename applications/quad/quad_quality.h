@@ -77,6 +77,9 @@ inline Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, cons
   return surface.face_normal(centre.face);
 }
 
+// The quads measure_quads counts as flipped or degenerate, by index.
+std::vector<int> bad_quads(const QuadMesh& quads, const SurfaceProjector& reference, const QuadQualityOptions& options = {});
+
 // Measures quads against the surface they approximate.
 //   corners  vertex indices expected to be irregular (the polycube's corners), may be empty
 // Throws std::invalid_argument for a bad quad index.

@@ -25,6 +25,9 @@ constexpr double kExtendedWorstFraction = 0.85;
 // ... and adds at most this factor of quads (a round of gargoyle's added 13 000 to 12 000 for
 // misses of 0.51-0.60 % spread over the model; rounds of 15-20 % met the bound with about half).
 constexpr double kExtendedRoundGrowth = 1.2;
+// Once a round's place cut a line by a bad quad, places within this many times the quad's size
+// on P (centre to farthest corner) of it are not refined again.
+constexpr double kBlockRadius = 3;
 
 // A pass's quads and what made them, into `to` (whose stage times and refinement figures stay).
 void take_pass(QuadRemeshResult& to, QuadRemeshResult pass) {
@@ -33,6 +36,7 @@ void take_pass(QuadRemeshResult& to, QuadRemeshResult pass) {
   to.smoothing = std::move(pass.smoothing);
   to.fitting = std::move(pass.fitting);
   to.refitting = std::move(pass.refitting);
+  to.untangling = std::move(pass.untangling);
 }
 
 std::string format(const char* pattern, double a, double b = 0, double c = 0) {
@@ -123,6 +127,25 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       say("fit", std::to_string(pass.fitting.snapped) + " corners pulled, farthest model vertex " +
                      format("%.4g -> %.4g from the quads", pass.fitting.farthest_before, pass.fitting.farthest_after));
     }
+    if (options.untangle.passes > 0) {
+      // Quads the map folded: their vertices moved apart where that unflips them (the fitted ones
+      // first kept, then, if quads stay flipped, free too).
+      begin = std::chrono::steady_clock::now();
+      pass.untangling = untangle_quads(pass.mesh, model, options.untangle, pass.fitting.pinned);
+      if (pass.untangling.flipped_after > 0 && !pass.fitting.pinned.empty()) {
+        const int flipped_before = pass.untangling.flipped_before, moves = pass.untangling.moves;
+        pass.untangling = untangle_quads(pass.untangling.mesh, model, options.untangle);
+        pass.untangling.flipped_before = flipped_before;
+        pass.untangling.moves += moves;
+      }
+      pass.mesh = std::move(pass.untangling.mesh);
+      pass.untangling.mesh = QuadMesh{};
+      pass.seconds_untangle += since(begin);
+      if (pass.untangling.flipped_before > 0)
+        say("untangle", std::to_string(pass.untangling.flipped_before) + " flipped quads -> " +
+                            std::to_string(pass.untangling.flipped_after) + ", " + std::to_string(pass.untangling.moves) +
+                            " vertex moves");
+    }
   };
   run_pass(result, false, nullptr);
 
@@ -170,6 +193,45 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     // the refinement, as does a round with more flipped or degenerate quads than the best.
     QuadRemeshResult current = result;
     int without_gain = 0;
+    // Where a round's quads came out flipped or degenerate (the map folds there): the round's
+    // places that cut a line bounding a bad quad or a quad round one are dropped, and balls on P
+    // round those places (kBlockRadius times the bad quad's size on P) are not refined again.
+    std::vector<std::pair<Eigen::Vector3d, double>> blocked;
+    const auto is_blocked = [&](const SurfacePoint& p) {
+      if (blocked.empty()) return false;
+      const Eigen::Vector3d x = surface_position(polycube, p);
+      for (const auto& [centre, radius] : blocked)
+        if ((x - centre).norm() <= radius) return true;
+      return false;
+    };
+    // The places of `places` (pass's last round) to blame for pass's bad quads, blocked; returns
+    // how many.
+    const auto blame = [&](const QuadRemeshResult& pass, std::vector<GridRefinement>& places) {
+      const PolycubeGrid& g = pass.grid;
+      const Eigen::MatrixX4i& Q = g.mesh.Q;
+      std::vector<double> size_of(places.size(), -1);  // per blamed place: its bad quad's size on P
+      std::vector<std::vector<int>> quads_of(g.mesh.num_vertices());
+      for (int q = 0; q < Q.rows(); ++q)
+        for (int k = 0; k < 4; ++k) quads_of[Q(q, k)].push_back(q);
+      for (int q : bad_quads(pass.mesh, model, options.quality)) {
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+        for (int k = 0; k < 4; ++k) centre += g.mesh.V.row(Q(q, k)).transpose() / 4;
+        double size = 0;
+        for (int k = 0; k < 4; ++k) size = std::max(size, (g.mesh.V.row(Q(q, k)).transpose() - centre).norm());
+        for (int k = 0; k < 4; ++k)
+          for (int r : quads_of[Q(q, k)]) {
+            const int n = g.quad_refined_by[r];
+            if (n >= 0 && n < static_cast<int>(places.size())) size_of[n] = std::max(size_of[n], size);
+          }
+      }
+      int blamed = 0;
+      for (size_t n = 0; n < places.size(); ++n)
+        if (size_of[n] >= 0) {
+          blocked.emplace_back(surface_position(polycube, places[n].point), kBlockRadius * size_of[n]);
+          ++blamed;
+        }
+      return blamed;
+    };
     for (int round = 0; !miss.points.empty(); ++round) {
       if (extended && result.refine_miss_after <= bound) break;  // what the extension was for
       if (round >= rounds && !extend(round)) break;
@@ -188,9 +250,52 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         const int halvings = std::clamp(static_cast<int>(std::lround(std::log2(miss.distances[k] / goal) / 2)), 1, 3);
         grid_options.refine_rounds.back().push_back({miss.points[k], halvings});
       }
+      std::vector<GridRefinement>& places = grid_options.refine_rounds.back();
+      places.erase(std::remove_if(places.begin(), places.end(), [&](const GridRefinement& r) { return is_blocked(r.point); }),
+                   places.end());
+      // The round's pass (into pass, next, pass_bad); false, and nothing changed, when the grid
+      // gains no part (the budget is spent, or every place was blocked).
       QuadRemeshResult pass;
-      pass.grid = build_polycube_grid(polycube, grid_options, size_map);
-      if (pass.grid.refined_parts == current.grid.refined_parts) {  // the budget is spent
+      QuadMiss next;
+      std::pair<int, int> pass_bad;
+      const auto attempt = [&]() {
+        PolycubeGrid grid = build_polycube_grid(polycube, grid_options, size_map);
+        if (grid.refined_parts == current.grid.refined_parts) return false;
+        pass = QuadRemeshResult{};
+        pass.grid = std::move(grid);
+        run_pass(pass, true, &current);
+        next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
+        pass_bad = bad(pass);
+        if (pass_bad.first > best_bad.first && options.refine.warm_sweeps > 0) {
+          // Started from the quads it refines, the round flipped a quad: the round's grid again as
+          // the first pass ran, carried by the map and relaxed with all the sweeps.
+          report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
+                               " flipped or degenerate quads from the quads it refines; again through the map");
+          QuadRemeshResult cold;
+          cold.grid = std::move(pass.grid);
+          run_pass(cold, true, nullptr);
+          pass = std::move(cold);
+          next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
+          pass_bad = bad(pass);
+        }
+        return true;
+      };
+      bool refined = attempt();
+      if (refined && pass_bad.first > best_bad.first) {
+        // The map folds where the round's lines went: once more without the places near the bad
+        // quads (nor, in later rounds, near any bad quad met).
+        const size_t before = places.size();
+        const std::vector<GridRefinement> kept_places = places;
+        blame(pass, places);
+        places.erase(std::remove_if(places.begin(), places.end(), [&](const GridRefinement& r) { return is_blocked(r.point); }),
+                     places.end());
+        report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
+                             " flipped or degenerate quads; again without the " + std::to_string(before - places.size()) +
+                             " of its " + std::to_string(before) + " places whose lines run by them");
+        // Else, or when that gains no part, the bad pass stays (with the places it was made from).
+        if (before == places.size() || places.empty() || !attempt()) places = kept_places;
+      }
+      if (!refined) {  // the budget is spent
         grid_options.refine_rounds.pop_back();
         if (extend(round)) {
           --round;
@@ -198,28 +303,19 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         }
         break;
       }
-      run_pass(pass, true, &current);
-      QuadMiss next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
-      auto pass_bad = bad(pass);
-      if (pass_bad.first > best_bad.first && options.refine.warm_sweeps > 0) {
-        // Started from the quads it refines, the round flipped a quad: the round's grid again as
-        // the first pass ran, carried by the map and relaxed with all the sweeps.
-        report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
-                             " flipped or degenerate quads from the quads it refines; again through the map");
-        QuadRemeshResult cold;
-        cold.grid = std::move(pass.grid);
-        run_pass(cold, true, nullptr);
-        pass = std::move(cold);
-        next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
-        pass_bad = bad(pass);
-      }
       report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass.grid.refined_parts) +
                            " chord parts halved, " + std::to_string(pass.grid.mesh.num_quads()) + " quads, misses by up to " +
                            format("%.3f %%", 100 * next.farthest / diagonal) + ", " + std::to_string(pass_bad.first) +
                            " flipped or degenerate quads, " + std::to_string(pass_bad.second) + " inverted corners (best so far " +
                            format("%.3f %%, ", 100 * result.refine_miss_after / diagonal) + std::to_string(best_bad.first) + ", " +
                            std::to_string(best_bad.second) + ")");
-      if (pass_bad.first > best_bad.first) break;
+      if (pass_bad.first > best_bad.first) {
+        // Not taken; the next round refines elsewhere (no place near the ones blamed).
+        blame(pass, grid_options.refine_rounds.back());
+        grid_options.refine_rounds.pop_back();
+        if (++without_gain == 2) break;
+        continue;
+      }
       // The stage times stay the first pass's (the refinement's, its passes included, is apart).
       take_pass(current, std::move(pass));
       miss = next;

@@ -7,6 +7,7 @@
 //   quads   = smooth_quads(quads, M)            optional: towards right angles, never flips a quad
 //   quads   = fit_quads(quads, M)               optional: corners pulled onto the model's tips,
 //                                               then relaxed again around them (pinned)
+//   quads   = untangle_quads(quads, M)          optional: flipped quads' vertices moved apart
 //   repeat: find_quad_misses(grid, quads, M)    optional: where the finished quads miss M, taken
 //           grid = build_polycube_grid(+ those) back to P; the chord parts there halved; the
 //           carry (kept vertices where the      grid carried (carry_refined_grid: the vertices
@@ -33,7 +34,7 @@
 namespace polycube {
 
 // Called when a step starts and when it ends: (stage, message). Stages: "grid", "carry",
-// "refine", "smooth", "fit", "quality".
+// "refine", "smooth", "fit", "untangle", "quality".
 using QuadProgress = std::function<void(const std::string& stage, const std::string& message)>;
 
 struct QuadRemeshOptions {
@@ -48,6 +49,9 @@ struct QuadRemeshOptions {
   // relaxation sweeps with the pulled vertices pinned (at most smooth.sweeps).
   QuadFitOptions fit;
   int refit_sweeps = 10;
+  // After the fit, the vertices of flipped quads moved apart where that unflips them (passes 0:
+  // not).
+  QuadUntangleOptions untangle;
   QuadQualityOptions quality;
   bool measure = true;  // false: skip measure_quads
 };
@@ -60,6 +64,7 @@ struct QuadRemeshOptions {
 //   smoothing  what the relaxation did (nothing when options.smooth.sweeps is 0)
 //   fitting    what the fit did (its mesh left empty; nothing when options.fit.passes is 0)
 //   refitting  the relaxation after the fit, pulled vertices pinned (its mesh left empty)
+//   untangling what the untangling did after the fit (its mesh left empty)
 //   quality    of mesh against M (quality.seconds: its time)
 //   seconds_*  wall time per stage
 struct QuadRemeshResult {
@@ -71,12 +76,14 @@ struct QuadRemeshResult {
   QuadSmoothResult smoothing;
   QuadFitResult fitting;
   QuadSmoothResult refitting;
+  QuadUntangleResult untangling;
   QuadQuality quality;
   double seconds_grid = 0;
   double seconds_carry = 0;
   double seconds_refine = 0;
   double seconds_smooth = 0;
   double seconds_fit = 0;
+  double seconds_untangle = 0;
   double seconds_quality = 0;
 };
 

@@ -621,4 +621,121 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   return result;
 }
 
+QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadUntangleOptions& options,
+                                  const std::vector<char>& pinned) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.passes < 0 || options.rings < 0)
+    throw std::invalid_argument("untangling passes and rings must be >= 0, got " + std::to_string(options.passes) + " and " +
+                                std::to_string(options.rings));
+  if (!pinned.empty() && static_cast<int>(pinned.size()) != quads.num_vertices())
+    throw std::invalid_argument("untangling: " + std::to_string(pinned.size()) + " pinned flags for " +
+                                std::to_string(quads.num_vertices()) + " vertices");
+  QuadUntangleResult result;
+  result.mesh = quads;
+  QuadMesh& mesh = result.mesh;
+  const int nv = mesh.num_vertices(), nq = mesh.num_quads();
+  const std::vector<std::vector<int>> neighbours = vertex_neighbours(mesh.Q, nv);
+  const std::vector<std::vector<int>> around = vertex_quads(mesh.Q, nv);
+  const double size = mean_quad_size(mesh);
+  const QuadGuard guard(mesh, surface);
+  // Per quad: flipped (its diagonals against the surface) and inverted corners, as measure_quads
+  // counts them (kCollapsedEdge aside: a corner with a collapsed edge counts as inverted here).
+  const auto badness = [&](int q) {
+    SurfaceHit centre;
+    const int bits = guard.state(q, centre, size);
+    int inverted = 0;
+    for (int k = 0; k < 4; ++k) inverted += !(bits & (1 << k));
+    return std::make_pair(bits & 16 ? 0 : 1, inverted);
+  };
+  std::vector<std::pair<int, int>> state(nq);
+  for (int q = 0; q < nq; ++q) state[q] = badness(q);
+  const auto count_flipped = [&]() {
+    int n = 0;
+    for (const auto& s : state) n += s.first;
+    return n;
+  };
+  result.flipped_before = result.flipped_after = count_flipped();
+  const auto sum_over = [&](int v, const std::vector<std::pair<int, int>>& of) {
+    std::pair<int, int> sum{0, 0};
+    for (size_t i = 0; i < around[v].size(); ++i) {
+      sum.first += of[i].first;
+      sum.second += of[i].second;
+    }
+    return sum;
+  };
+  std::vector<std::pair<int, int>> before, after;
+  std::vector<Eigen::Vector3d> targets;
+  // Tries to move v; true when it moved.
+  const auto try_vertex = [&](int v) {
+    if ((!pinned.empty() && pinned[v]) || neighbours[v].empty()) return false;
+    before.clear();
+    for (int q : around[v]) before.push_back(state[q]);
+    const std::pair<int, int> was = sum_over(v, before);
+    if (was.first == 0 && was.second == 0) return false;
+    const Eigen::Vector3d p = mesh.V.row(v);
+    const SurfaceHit here = surface.closest(p);
+    // The mean of the edge neighbours, of the quads' centres, of the parallelogram corners
+    // a + c - b (a, b, c: the quad's other corners in order, b opposite v) and each flipped quad's.
+    targets.assign(3, Eigen::Vector3d::Zero());
+    for (int w : neighbours[v]) targets[0] += mesh.V.row(w).transpose() / static_cast<double>(neighbours[v].size());
+    for (int q : around[v]) {
+      int c = 0;
+      while (mesh.Q(q, c) != v) ++c;
+      const Eigen::Vector3d parallelogram = mesh.V.row(mesh.Q(q, (c + 1) % 4)) + mesh.V.row(mesh.Q(q, (c + 3) % 4)) -
+                                            mesh.V.row(mesh.Q(q, (c + 2) % 4));
+      targets[1] += (p + mesh.V.row(mesh.Q(q, (c + 1) % 4)).transpose() + mesh.V.row(mesh.Q(q, (c + 2) % 4)).transpose() +
+                     mesh.V.row(mesh.Q(q, (c + 3) % 4)).transpose()) /
+                    (4.0 * around[v].size());
+      targets[2] += parallelogram / static_cast<double>(around[v].size());
+      if (state[q].first > 0) targets.push_back(parallelogram);
+    }
+    for (const Eigen::Vector3d& target : targets)
+      for (double t : {1.0, 0.5, 0.25}) {
+        const SurfaceHit hit = surface.closest(p + t * (target - p), here);
+        if (hit.normal.dot(here.normal) < kSameSheet) continue;
+        mesh.V.row(v) = hit.point.transpose();
+        after.clear();
+        for (int q : around[v]) after.push_back(badness(q));
+        if (sum_over(v, after) < was) {
+          for (size_t i = 0; i < around[v].size(); ++i) state[around[v][i]] = after[i];
+          ++result.moves;
+          return true;
+        }
+        mesh.V.row(v) = p.transpose();
+      }
+    return false;
+  };
+  for (int pass = 0; pass < options.passes; ++pass) {
+    // The vertices of the bad quads and, ring by ring, round them, while a ring gains nothing.
+    std::vector<char> in(nv, 0);
+    std::vector<int> front;
+    for (int q = 0; q < nq; ++q)
+      if (state[q].first > 0)
+        for (int k = 0; k < 4; ++k)
+          if (!in[mesh.Q(q, k)]) {
+            in[mesh.Q(q, k)] = 1;
+            front.push_back(mesh.Q(q, k));
+          }
+    if (front.empty()) break;
+    bool moved = false;
+    for (int ring = 0; ring <= options.rings && !moved; ++ring) {
+      if (ring > 0) {
+        std::vector<int> next;
+        for (int v : front)
+          for (int w : neighbours[v])
+            if (!in[w]) {
+              in[w] = 1;
+              next.push_back(w);
+            }
+        front.insert(front.end(), next.begin(), next.end());
+      }
+      for (int v : front) moved = try_vertex(v) || moved;
+    }
+    if (!moved) break;
+  }
+  result.flipped_after = count_flipped();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
 }  // namespace polycube

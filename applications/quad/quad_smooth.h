@@ -131,4 +131,31 @@ struct QuadFitResult {
 QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options = {},
                         const std::vector<char>& pinned = {});
 
+// Untangling the quads a map folded: vertices of flipped quads (and, when that is not enough,
+// within `rings` rings of quads of them) move, one at a time, towards the mean of their edge
+// neighbours, then the mean of their quads' centres (full, half or a quarter of the way, on the
+// surface near the vertex: a closest point whose normal is within about 70° of the vertex's). A
+// move is taken only if, over the vertex's quads, it lowers (flipped quads, inverted corners) in
+// that order, both judged as measure_quads judges them (a corner with a collapsed edge counts as
+// inverted); so the flipped quads in all never grow. Passes repeat while they gain.
+struct QuadUntangleOptions {
+  int passes = 10;
+  int rings = 2;
+};
+
+//   mesh           the quads (same connectivity)
+//   moves          vertex moves taken
+//   flipped_before, flipped_after  flipped quads as measure_quads counts them
+struct QuadUntangleResult {
+  QuadMesh mesh;
+  int moves = 0;
+  int flipped_before = 0, flipped_after = 0;
+  double seconds = 0;
+};
+
+// pinned (empty, or one flag per vertex): vertices that do not move.
+// Throws std::invalid_argument for negative passes or rings, or pinned flags of the wrong size.
+QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadUntangleOptions& options = {},
+                                  const std::vector<char>& pinned = {});
+
 }  // namespace polycube

@@ -273,10 +273,10 @@ double triangle_area(const TriMesh& mesh, int f) {
   return (b - a).cross(c - a).norm() / 2;
 }
 
-// The sides of the grid quads on P that contain point x (on the plane of triangle f's face).
-std::vector<double> sides_of_quads_at(const TriMesh& P, const PolycubeGrid& grid, int f, const Eigen::Vector3d& x) {
+// The grid quads on P that contain point x (on the plane of triangle f's face).
+std::vector<int> quads_at(const TriMesh& P, const PolycubeGrid& grid, int f, const Eigen::Vector3d& x) {
   const Eigen::Vector3d n = (P.V.row(P.F(f, 1)) - P.V.row(P.F(f, 0))).cross(P.V.row(P.F(f, 2)) - P.V.row(P.F(f, 0))).transpose();
-  std::vector<double> sides;
+  std::vector<int> out;
   for (int q = 0; q < grid.mesh.num_quads(); ++q) {
     const int axis = std::abs(grid.quad_axis[q]) - 1;
     if (n.cwiseAbs().maxCoeff() != std::abs(n[axis]) || (n[axis] > 0) != (grid.quad_axis[q] > 0)) continue;
@@ -287,6 +287,21 @@ std::vector<double> sides_of_quads_at(const TriMesh& P, const PolycubeGrid& grid
       hi = hi.cwiseMax(grid.mesh.V.row(grid.mesh.Q(q, k)).transpose());
     }
     if (((x - lo).array() < -1e-12).any() || ((hi - x).array() < -1e-12).any()) continue;
+    out.push_back(q);
+  }
+  return out;
+}
+
+// The sides of the grid quads on P that contain point x (on the plane of triangle f's face).
+std::vector<double> sides_of_quads_at(const TriMesh& P, const PolycubeGrid& grid, int f, const Eigen::Vector3d& x) {
+  std::vector<double> sides;
+  for (int q : quads_at(P, grid, f, x)) {
+    const int axis = std::abs(grid.quad_axis[q]) - 1;
+    Eigen::Vector3d lo = grid.mesh.V.row(grid.mesh.Q(q, 0)), hi = lo;
+    for (int k = 1; k < 4; ++k) {
+      lo = lo.cwiseMin(grid.mesh.V.row(grid.mesh.Q(q, k)).transpose());
+      hi = hi.cwiseMax(grid.mesh.V.row(grid.mesh.Q(q, k)).transpose());
+    }
     for (int a = 0; a < 3; ++a)
       if (a != axis) sides.push_back(hi[a] - lo[a]);
   }
@@ -353,6 +368,55 @@ TEST(QuadGrid, RefinementHalvesThePartsAtAPoint) {
     EXPECT_THROW(build_polycube_grid(P, twice), std::invalid_argument);
     twice.refine_rounds = {{GridRefinement{point, 0}}};
     EXPECT_THROW(build_polycube_grid(P, twice), std::invalid_argument);
+  }
+}
+
+// Each quad names the point of the last round whose cut line bounds it (what the quad remesh
+// blames a round's flipped quads on): the quads at that point, and only the last round's points.
+TEST(QuadGrid, QuadsNameTheLastRoundsPointThatCutThem) {
+  for (const Shape& shape : synthetic_shapes()) {
+    SCOPED_TRACE(shape.name);
+    const TriMesh& P = shape.mesh;
+    PolycubeGridOptions options;
+    options.target_quads = 300;
+    const PolycubeGrid base = build_polycube_grid(P, options);
+    ASSERT_EQ(base.quad_refined_by.size(), base.mesh.num_quads());
+    EXPECT_EQ(base.quad_refined_by.maxCoeff(), -1);
+    // Two points on two faces of different axes, one per round, then both in one round.
+    int f = 0;
+    for (int g = 0; g < P.num_faces(); ++g)
+      if (triangle_area(P, g) > triangle_area(P, f)) f = g;
+    const auto axis_of = [&](int g) {
+      const Eigen::Vector3d n = (P.V.row(P.F(g, 1)) - P.V.row(P.F(g, 0))).cross(P.V.row(P.F(g, 2)) - P.V.row(P.F(g, 0)));
+      int a = 0;
+      n.cwiseAbs().maxCoeff(&a);
+      return a;
+    };
+    int h = -1;
+    for (int g = 0; g < P.num_faces(); ++g)
+      if (axis_of(g) != axis_of(f) && (h < 0 || triangle_area(P, g) > triangle_area(P, h))) h = g;
+    ASSERT_GE(h, 0);
+    const SurfacePoint a{f, Eigen::Vector3d(0.21, 0.33, 0.46)}, b{h, Eigen::Vector3d(0.4, 0.35, 0.25)};
+    const auto at = [&](const SurfacePoint& p) {
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      for (int i = 0; i < 3; ++i) x += p.bary[i] * P.V.row(P.F(p.face, i)).transpose();
+      return x;
+    };
+    options.refine_rounds = {{GridRefinement{a, 1}}, {GridRefinement{b, 1}}};
+    const PolycubeGrid two = build_polycube_grid(P, options);
+    ASSERT_EQ(two.refined_parts, 4);
+    ASSERT_EQ(two.quad_refined_by.size(), two.mesh.num_quads());
+    EXPECT_EQ(two.quad_refined_by.minCoeff(), -1) << "quads away from the last round's lines";
+    EXPECT_EQ(two.quad_refined_by.maxCoeff(), 0) << "the last round has one point";
+    for (int q : quads_at(P, two, h, at(b))) EXPECT_EQ(two.quad_refined_by[q], 0);
+    options.refine_rounds = {{GridRefinement{a, 1}, GridRefinement{b, 1}}};
+    const PolycubeGrid one = build_polycube_grid(P, options);
+    // A quad names the latest of the points whose lines bound it.
+    const std::vector<int> at_a = quads_at(P, one, f, at(a)), at_b = quads_at(P, one, h, at(b));
+    ASSERT_FALSE(at_a.empty());
+    ASSERT_FALSE(at_b.empty());
+    for (int q : at_a) EXPECT_GE(one.quad_refined_by[q], 0);
+    for (int q : at_b) EXPECT_EQ(one.quad_refined_by[q], 1);
   }
 }
 

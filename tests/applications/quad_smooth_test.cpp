@@ -111,6 +111,71 @@ TriMesh thin_box(double thickness) {
   return box;
 }
 
+// A 4 x 4 grid of quads on the box's top face with its middle vertex dragged past a diagonal
+// neighbour: the quads round it fold. The untangling unfolds them all; pinned, it leaves the pin.
+TEST(QuadUntangle, UnfoldsAFoldedVertex) {
+  const TriMesh box = thin_box(0.1);
+  const SurfaceProjector top(box);
+  QuadMesh grid;
+  grid.V.resize(25, 3);
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) grid.V.row(5 * i + j) << 0.1 + 0.2 * i, 0.1 + 0.2 * j, 0.1;
+  grid.Q.resize(16, 4);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) grid.Q.row(4 * i + j) << 5 * i + j, 5 * (i + 1) + j, 5 * (i + 1) + j + 1, 5 * i + j + 1;
+  QuadQualityOptions no_distance;
+  no_distance.hausdorff = false;
+  ASSERT_EQ(measure_quads(grid, top, {}, no_distance).flipped_quads, 0);
+  const int middle = 12;
+  grid.V.row(middle) << 0.22, 0.24, 0.1;  // past vertex 6 at (0.3, 0.3)
+  const int folded = measure_quads(grid, top, {}, no_distance).flipped_quads;
+  ASSERT_GT(folded, 0) << "the test needs folded quads";
+
+  const QuadUntangleResult r = untangle_quads(grid, top);
+  EXPECT_EQ(r.mesh.Q, grid.Q);
+  EXPECT_EQ(r.flipped_before, folded);
+  EXPECT_EQ(r.flipped_after, 0);
+  EXPECT_EQ(measure_quads(r.mesh, top, {}, no_distance).flipped_quads, 0);
+  EXPECT_GT(r.moves, 0);
+  for (int v = 0; v < 25; ++v) EXPECT_NEAR(r.mesh.V(v, 2), 0.1, 1e-12) << "on the top face";
+
+  std::vector<char> pinned(25, 0);
+  pinned[middle] = 1;
+  const QuadUntangleResult held = untangle_quads(grid, top, {}, pinned);
+  EXPECT_EQ(held.mesh.V.row(middle), grid.V.row(middle));
+  EXPECT_LE(held.flipped_after, folded);
+
+  QuadUntangleOptions none;
+  none.passes = 0;
+  EXPECT_EQ(untangle_quads(grid, top, none).mesh.V, grid.V);
+  none.passes = -1;
+  EXPECT_THROW(untangle_quads(grid, top, none), std::invalid_argument);
+  EXPECT_THROW(untangle_quads(grid, top, {}, std::vector<char>(3, 0)), std::invalid_argument);
+}
+
+// On a real tangled map (anchor's unrelaxed quads) the untangling lowers the flipped quads
+// without touching the connectivity, and keeps every vertex on the model.
+TEST(QuadUntangle, LowersTheFlippedQuadsOfATangledMap) {
+  const Mapped& m = mapped("anchor.off");
+  QuadRemeshOptions options;
+  options.grid.target_quads = 3000;
+  options.smooth.sweeps = 0;
+  options.refine.rounds = 0;
+  options.untangle.passes = 0;
+  const SurfaceMap to_model = [&m](const SurfacePoint& p) { return surface_position(m.model, m.map.to_model(p)); };
+  const QuadRemeshResult before = remesh_quads(m.polycube.polycube.mesh, to_model, *m.projector, options);
+  ASSERT_GT(before.quality.flipped_quads, 0) << "the test needs a tangled map";
+  const QuadUntangleResult r = untangle_quads(before.mesh, *m.projector);
+  EXPECT_EQ(r.flipped_before, before.quality.flipped_quads);
+  QuadQualityOptions no_distance;
+  no_distance.hausdorff = false;
+  const QuadQuality after = measure_quads(r.mesh, *m.projector, before.grid.corners, no_distance);
+  EXPECT_EQ(after.flipped_quads, r.flipped_after);
+  EXPECT_LT(r.flipped_after, before.quality.flipped_quads) << before.quality.flipped_quads << " -> " << r.flipped_after;
+  EXPECT_LE(after.max_distance_to_surface, 1e-9 * after.diagonal);
+  EXPECT_EQ(r.mesh.Q, before.mesh.Q);
+}
+
 TEST(SurfaceProjector, WalkOnASheetMatchesTheTreeNearTheSurface) {
   // Points a little off a model, walked to from the closest point of a vertex nearby. On a convex
   // model the walk finds what the tree finds; elsewhere it can stop on its face where a concave
