@@ -38,12 +38,15 @@ struct QuadRefineOptions {
   // quads. 0: no bound.
   double bound_percent = 0.5;
   double bound_growth = 3;
-  int bound_rounds = 4;
+  int bound_rounds = 8;
   // A round's grid keeps the places the quads it refines have for the vertices it shares with
   // them (carry_refined_grid: only the added lines are carried by the map) and is relaxed with at
   // most this many sweeps; 0: all carried by the map and relaxed with all the sweeps, as the
   // first pass.
   int warm_sweeps = 15;
+  // A warm round relaxes only the vertices of quads with a new corner and of this many rings of
+  // quads round them; the others keep their places. -1: every vertex relaxes.
+  int local_rings = 2;
   // Threads for the distance queries and the map's values at P's vertices (the map must then be
   // thread-safe); 0: one per hardware thread, 1: the calling thread.
   int threads = 1;

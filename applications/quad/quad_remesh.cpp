@@ -99,10 +99,31 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         if (same[Q(q, 0)] < 0 || same[Q(q, 1)] < 0 || same[Q(q, 2)] < 0 || same[Q(q, 3)] < 0)
           for (int k = 0; k < 4; ++k) fitted[Q(q, k)] = 0;
     }
+    // A warm round relaxes only round the lines it added (quads with a new corner and
+    // options.refine.local_rings rings of quads round them); elsewhere the vertices keep the places
+    // the quads it refines gave them, so what those quads already fitted does not move about.
+    std::vector<char> held = fitted;
+    if (warm && options.refine.local_rings >= 0) {
+      const Eigen::MatrixX4i& Q = pass.grid.mesh.Q;
+      const int nv = pass.grid.mesh.num_vertices();
+      std::vector<char> free(nv, 0);
+      for (int q = 0; q < Q.rows(); ++q)
+        if (same[Q(q, 0)] < 0 || same[Q(q, 1)] < 0 || same[Q(q, 2)] < 0 || same[Q(q, 3)] < 0)
+          for (int k = 0; k < 4; ++k) free[Q(q, k)] = 1;
+      for (int ring = 0; ring < options.refine.local_rings; ++ring) {
+        std::vector<char> next = free;
+        for (int q = 0; q < Q.rows(); ++q)
+          if (free[Q(q, 0)] || free[Q(q, 1)] || free[Q(q, 2)] || free[Q(q, 3)])
+            for (int k = 0; k < 4; ++k) next[Q(q, k)] = 1;
+        free = std::move(next);
+      }
+      held.resize(nv, 0);
+      for (int v = 0; v < nv; ++v) held[v] = held[v] || !free[v];
+    }
     if (smooth.sweeps > 0) {
       say("smooth", "up to " + std::to_string(smooth.sweeps) + " relaxation sweeps towards right angles");
       begin = std::chrono::steady_clock::now();
-      pass.smoothing = smooth_quads(pass.mesh, model, smooth, fitted);
+      pass.smoothing = smooth_quads(pass.mesh, model, smooth, held);
       pass.mesh = std::move(pass.smoothing.mesh);
       pass.smoothing.mesh = QuadMesh{};  // one copy is enough
       pass.seconds_smooth += since(begin);
@@ -119,7 +140,9 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       if (pass.fitting.snapped > 0 && smooth.sweeps > 0 && options.refit_sweeps > 0) {
         QuadSmoothOptions again = smooth;
         again.sweeps = std::min(options.refit_sweeps, smooth.sweeps);
-        pass.refitting = smooth_quads(pass.mesh, model, again, pass.fitting.pinned);
+        std::vector<char> pinned = pass.fitting.pinned;
+        for (size_t v = 0; v < pinned.size() && v < held.size(); ++v) pinned[v] = pinned[v] || held[v];
+        pass.refitting = smooth_quads(pass.mesh, model, again, pinned);
         pass.mesh = std::move(pass.refitting.mesh);
         pass.refitting.mesh = QuadMesh{};
       }
@@ -310,10 +333,11 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
                            format("%.3f %%, ", 100 * result.refine_miss_after / diagonal) + std::to_string(best_bad.first) + ", " +
                            std::to_string(best_bad.second) + ")");
       if (pass_bad.first > best_bad.first) {
-        // Not taken; the next round refines elsewhere (no place near the ones blamed).
-        blame(pass, grid_options.refine_rounds.back());
+        // Not taken; the next round refines elsewhere (no place near the ones blamed). With none
+        // blamed it would make the same grid: the end.
+        const int blamed = blame(pass, grid_options.refine_rounds.back());
         grid_options.refine_rounds.pop_back();
-        if (++without_gain == 2) break;
+        if (blamed == 0 || ++without_gain == 2) break;
         continue;
       }
       // The stage times stay the first pass's (the refinement's, its passes included, is apart).

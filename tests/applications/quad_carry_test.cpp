@@ -337,6 +337,51 @@ TEST(QuadCarry, RefinementGoesOnToTheBound) {
   EXPECT_TRUE(bounded.quality.topology.closed_manifold());
 }
 
+// A warm round relaxes only round the lines it added: the vertices it shares with the quads it
+// refines, away from quads with a new corner (more than refine.local_rings rings), keep their
+// places exactly; with local_rings -1 the relaxation moves them too.
+TEST(QuadCarry, WarmRoundRelaxesOnlyRoundTheAddedLines) {
+  const HornedSphere& h = horned_sphere();
+  QuadRemeshOptions options = horn_options(1500, 0);
+  options.fit.passes = 0;
+  options.untangle.passes = 0;
+  const QuadRemeshResult uniform = remesh_quads(h.P, h.radial, *h.model, options);
+  options.refine.rounds = 1;
+  options.refine.bound_percent = 0;
+  const auto kept_far_from_new_quads = [&](const QuadRemeshResult& r, int rings, int& far) {
+    const std::vector<int> same = same_grid_vertices(uniform.grid, r.grid);
+    const Eigen::MatrixX4i& Q = r.grid.mesh.Q;
+    std::vector<char> near(r.mesh.num_vertices(), 0);
+    for (int q = 0; q < Q.rows(); ++q)
+      if (same[Q(q, 0)] < 0 || same[Q(q, 1)] < 0 || same[Q(q, 2)] < 0 || same[Q(q, 3)] < 0)
+        for (int k = 0; k < 4; ++k) near[Q(q, k)] = 1;
+    for (int ring = 0; ring < rings; ++ring) {
+      std::vector<char> next = near;
+      for (int q = 0; q < Q.rows(); ++q)
+        if (near[Q(q, 0)] || near[Q(q, 1)] || near[Q(q, 2)] || near[Q(q, 3)])
+          for (int k = 0; k < 4; ++k) next[Q(q, k)] = 1;
+      near = std::move(next);
+    }
+    int kept = 0;
+    far = 0;
+    for (int v = 0; v < r.mesh.num_vertices(); ++v) {
+      if (near[v] || same[v] < 0) continue;
+      ++far;
+      kept += r.mesh.V.row(v) == uniform.mesh.V.row(same[v]);
+    }
+    return kept;
+  };
+  const QuadRemeshResult local = remesh_quads(h.P, h.radial, *h.model, options);
+  ASSERT_EQ(local.refine_rounds, 1);
+  int far = 0;
+  EXPECT_EQ(kept_far_from_new_quads(local, options.refine.local_rings, far), far);
+  EXPECT_GT(far, uniform.mesh.num_vertices() / 2) << "most of the grid is away from the horn's lines";
+  options.refine.local_rings = -1;
+  const QuadRemeshResult everywhere = remesh_quads(h.P, h.radial, *h.model, options);
+  ASSERT_EQ(everywhere.refine_rounds, 1);
+  EXPECT_LT(kept_far_from_new_quads(everywhere, 2, far), far / 2);
+}
+
 // A refinement round's grid: the vertices it shares with the grid it refines where the finished
 // quads have them; the added ones at their images shifted as the old vertices round them were
 // (so within twice the largest shift of their images), on the model.

@@ -103,7 +103,7 @@ TEST(QuadCli, QuadsThatFallShortTryTheNextOrientations) {
   const nlohmann::json& tried = report["alignment"]["tried"];
   ASSERT_GE(tried.size(), 2u);
   auto short_of = [](const nlohmann::json& t) {
-    return t["flipped"].get<int>() + t["degenerate"].get<int>() > 0 || t["hausdorff_percent"].get<double>() > 1.0;
+    return t["flipped"].get<int>() + t["degenerate"].get<int>() > 0 || t["hausdorff_percent"].get<double>() > 0.5;
   };
   auto rank = [](const nlohmann::json& t) {
     return std::make_tuple(t["flipped"].get<int>() + t["degenerate"].get<int>(), t["hausdorff_percent"].get<double>() > 0.5 ? 1 : 0,
