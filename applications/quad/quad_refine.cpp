@@ -111,6 +111,10 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
   // Per candidate: its distance and its point of P (set when a miss).
   std::vector<double> miss(ns + nq, 0);
   std::vector<SurfacePoint> where(ns + nq);
+  // A model point's second place: on P under the point of the quads closest to it (the quad
+  // that cuts across it), where the preimage through the chords may lie off the quads' lines.
+  std::vector<SurfacePoint> under_quad(ns);
+  const TriMesh& quad_triangles = on_quads.surface();
   // The model's points first on the quads' sheet, walking from a neighbour's closest point (the
   // vertices in breadth-first order): a walk's distance is never below the true one, so only the
   // points it leaves beyond `distance` need the whole search (most need none: a walk is many
@@ -122,8 +126,15 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
     if (k < ns) {
       miss[k] = near[k].distance;
       if (miss[k] <= distance) return;
-      miss[k] = on_quads.closest(samples[k], near[k]).distance;
-      if (miss[k] > distance) where[k] = locator.preimage(samples[k]);
+      const SurfaceHit hit = on_quads.closest(samples[k], near[k]);
+      miss[k] = hit.distance;
+      if (miss[k] > distance) {
+        where[k] = locator.preimage(samples[k]);
+        const SurfacePoint on_quad = surface_point(quad_triangles, hit.face, hit.point);
+        Eigen::Vector3d on_p = Eigen::Vector3d::Zero();
+        for (int i = 0; i < 3; ++i) on_p += on_quad.bary[i] * grid.mesh.V.row(quad_triangles.F(hit.face, i)).transpose();
+        under_quad[k] = locator.on_polycube(on_p);
+      }
     } else {
       miss[k] = model.closest(quad_points[k - ns]).distance;
       if (miss[k] > distance) where[k] = locator.on_polycube(quad_points_on_p[k - ns]);
@@ -139,6 +150,10 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
   for (int k : order) {
     result.points.push_back(where[k]);
     result.distances.push_back(miss[k]);
+    if (k < ns) {
+      result.points.push_back(under_quad[k]);
+      result.distances.push_back(miss[k]);
+    }
   }
   return result;
 }

@@ -71,7 +71,8 @@ class PreimageLocator {
 
 // Where quads on M (the grid carried, perhaps relaxed: same connectivity) miss M by more than
 // `distance`:
-//   points    points of P to refine at, the worst first: the preimages of the points of M
+//   points    points of P to refine at, the worst first: the preimages (and the points of P
+//             under the quads' closest points) of the points of M
 //             farther than `distance` from the quads (two triangles each) — M's vertices, the
 //             centroids of its triangles longer than cell_size / 4 and points along its edges
 //             longer than that, at most cell_size / 4 apart (a coarse CAD mesh is missed between
