@@ -5,10 +5,12 @@
 #include "applications/quad/carry_grid.h"
 #include "applications/quad/polycube_grid.h"
 #include "applications/quad/quad_quality.h"
+#include "applications/quad/quad_refine.h"
 #include "applications/quad/quad_remesh.h"
 #include "applications/quad/quad_smooth.h"
 #include "applications/quad/surface_projector.h"
 
+#include "polycube/closest_point.h"
 #include "polycube/errors.h"
 #include "polycube/polycube_build.h"
 #include "polycube/topology.h"
@@ -424,6 +426,51 @@ TEST(QuadCarry, RefinedGridKeepsTheFinishedPlaces) {
 
 // A refined grid keeps the lines of the grid it refines: every vertex of the coarse grid is a vertex
 // of the refined one, found at its place; the added vertices match none.
+// The misses of uniform quads on the horned sphere: each missed model point comes with two places
+// on P, its preimage through the chords and the point of P under the quads' closest point to it
+// (its image through the quads is that closest point, at the miss's distance from a model point).
+TEST(QuadCarry, MissesComeWithThePlaceUnderTheQuads) {
+  const HornedSphere& h = horned_sphere();
+  QuadRemeshOptions options = horn_options(1500, 0);
+  const QuadRemeshResult r = remesh_quads(h.P, h.radial, *h.model, options);
+  const PreimageLocator locator(h.P, h.radial, 1);
+  const double diagonal = r.quality.diagonal;
+  const QuadMiss miss = find_quad_misses(r.grid, r.mesh, *h.model, locator, 0.0025 * diagonal, r.grid.cell_size, 1);
+  ASSERT_GE(miss.points.size(), 2u);
+  EXPECT_NEAR(miss.distances[0], miss.farthest, 1e-12 * diagonal);
+  // The grid's quads on P, split as the quads on M are, to carry points of P onto the quads.
+  const TriMesh on_m = triangulate_quads(r.mesh);
+  TriMesh on_p = on_m;
+  on_p.V = r.grid.mesh.V;
+  const SurfaceProjector grid_on_p(on_p), quads_on_m(on_m);
+  const TriMesh& model = h.model->surface();
+  int matched = 0, pairs = 0;
+  for (size_t k = 0; k + 1 < miss.points.size() && pairs < 20; ++k) {
+    if (miss.distances[k + 1] != miss.distances[k]) continue;
+    ++pairs;
+    const Eigen::Vector3d second = surface_position(h.P, miss.points[k + 1]);
+    const SurfaceHit in_grid = grid_on_p.closest(second);
+    ASSERT_LT(in_grid.distance, 1e-9 * diagonal) << "a point of P on the grid's quads";
+    const TriangleClosest t = closest_on_triangle(second, on_p.V.row(on_p.F(in_grid.face, 0)).transpose(),
+                                                  on_p.V.row(on_p.F(in_grid.face, 1)).transpose(),
+                                                  on_p.V.row(on_p.F(in_grid.face, 2)).transpose());
+    Eigen::Vector3d image = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) image += t.bary[i] * on_m.V.row(on_m.F(in_grid.face, i)).transpose();
+    // A model vertex (the samples include them) whose closest point on the quads is that image.
+    for (int v = 0; v < model.num_vertices(); ++v) {
+      const Eigen::Vector3d x = model.V.row(v);
+      if (std::abs((x - image).norm() - miss.distances[k]) < 1e-6 * diagonal &&
+          (quads_on_m.closest(x).point - image).norm() < 1e-6 * diagonal) {
+        ++matched;
+        break;
+      }
+    }
+    ++k;
+  }
+  EXPECT_GT(pairs, 0);
+  EXPECT_GT(matched, 0) << "of " << pairs << " pairs";
+}
+
 TEST(QuadCarry, SameGridVerticesOfARefinedGrid) {
   const TriMesh P = cube();
   PolycubeGridOptions options;

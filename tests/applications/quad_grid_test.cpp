@@ -273,6 +273,13 @@ double triangle_area(const TriMesh& mesh, int f) {
   return (b - a).cross(c - a).norm() / 2;
 }
 
+int largest_triangle(const TriMesh& mesh) {
+  int f = 0;
+  for (int g = 1; g < mesh.num_faces(); ++g)
+    if (triangle_area(mesh, g) > triangle_area(mesh, f)) f = g;
+  return f;
+}
+
 // The grid quads on P that contain point x (on the plane of triangle f's face).
 std::vector<int> quads_at(const TriMesh& P, const PolycubeGrid& grid, int f, const Eigen::Vector3d& x) {
   const Eigen::Vector3d n = (P.V.row(P.F(f, 1)) - P.V.row(P.F(f, 0))).cross(P.V.row(P.F(f, 2)) - P.V.row(P.F(f, 0))).transpose();
@@ -319,9 +326,7 @@ TEST(QuadGrid, RefinementHalvesThePartsAtAPoint) {
     options.target_quads = 300;
     const PolycubeGrid base = build_polycube_grid(P, options);
     // A point inside a face, on no dyadic line: in the largest triangle.
-    int f = 0;
-    for (int g = 0; g < P.num_faces(); ++g)
-      if (triangle_area(P, g) > triangle_area(P, f)) f = g;
+    const int f = largest_triangle(P);
     SurfacePoint point;
     point.face = f;
     point.bary = Eigen::Vector3d(0.21, 0.33, 0.46);
@@ -383,9 +388,7 @@ TEST(QuadGrid, QuadsNameTheLastRoundsPointThatCutThem) {
     ASSERT_EQ(base.quad_refined_by.size(), base.mesh.num_quads());
     EXPECT_EQ(base.quad_refined_by.maxCoeff(), -1);
     // Two points on two faces of different axes, one per round, then both in one round.
-    int f = 0;
-    for (int g = 0; g < P.num_faces(); ++g)
-      if (triangle_area(P, g) > triangle_area(P, f)) f = g;
+    const int f = largest_triangle(P);
     const auto axis_of = [&](int g) {
       const Eigen::Vector3d n = (P.V.row(P.F(g, 1)) - P.V.row(P.F(g, 0))).cross(P.V.row(P.F(g, 2)) - P.V.row(P.F(g, 0)));
       int a = 0;
