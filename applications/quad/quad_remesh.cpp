@@ -89,14 +89,19 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     // A round's vertices that the quads it refines had pulled onto the model's tips start there
     // and stay, unless a line was added next to them (a quad round them has a new corner): the
     // fit is not undone where nothing changed, and is done again where lines were added.
+    const Eigen::MatrixX4i& Q = pass.grid.mesh.Q;
+    const int nv = pass.grid.mesh.num_vertices();
+    std::vector<char> added;  // per quad of a warm round: it has a new corner
+    if (warm) {
+      added.assign(Q.rows(), 0);
+      for (int q = 0; q < Q.rows(); ++q) added[q] = same[Q(q, 0)] < 0 || same[Q(q, 1)] < 0 || same[Q(q, 2)] < 0 || same[Q(q, 3)] < 0;
+    }
     std::vector<char> fitted;
     if (warm && !from->fitting.pinned.empty()) {
-      const int nv = pass.grid.mesh.num_vertices();
       fitted.assign(nv, 0);
       for (int v = 0; v < nv; ++v) fitted[v] = same[v] >= 0 && from->fitting.pinned[same[v]];
-      const Eigen::MatrixX4i& Q = pass.grid.mesh.Q;
       for (int q = 0; q < Q.rows(); ++q)
-        if (same[Q(q, 0)] < 0 || same[Q(q, 1)] < 0 || same[Q(q, 2)] < 0 || same[Q(q, 3)] < 0)
+        if (added[q])
           for (int k = 0; k < 4; ++k) fitted[Q(q, k)] = 0;
     }
     // A warm round relaxes only round the lines it added (quads with a new corner and
@@ -104,11 +109,9 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     // the quads it refines gave them, so what those quads already fitted does not move about.
     std::vector<char> held = fitted;
     if (warm && options.refine.local_rings >= 0) {
-      const Eigen::MatrixX4i& Q = pass.grid.mesh.Q;
-      const int nv = pass.grid.mesh.num_vertices();
       std::vector<char> free(nv, 0);
       for (int q = 0; q < Q.rows(); ++q)
-        if (same[Q(q, 0)] < 0 || same[Q(q, 1)] < 0 || same[Q(q, 2)] < 0 || same[Q(q, 3)] < 0)
+        if (added[q])
           for (int k = 0; k < 4; ++k) free[Q(q, k)] = 1;
       for (int ring = 0; ring < options.refine.local_rings; ++ring) {
         std::vector<char> next = free;
@@ -213,7 +216,8 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     // The rounds go on from the latest pass (`current`) even when it misses no less than the best
     // so far (the farthest miss moves about from pass to pass: the relaxation and the fit differ
     // where lines were added); the best is kept, and two rounds in a row without a better one end
-    // the refinement, as does a round with more flipped or degenerate quads than the best.
+    // the refinement. A round with more flipped or degenerate quads than the best is not taken
+    // (see blame below).
     QuadRemeshResult current = result;
     int without_gain = 0;
     // Where a round's quads came out flipped or degenerate (the map folds there): the round's
@@ -304,19 +308,23 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         return true;
       };
       bool refined = attempt();
+      int blamed = -1;  // places blamed for this pass's bad quads (-1: not yet)
       if (refined && pass_bad.first > best_bad.first) {
         // The map folds where the round's lines went: once more without the places near the bad
         // quads (nor, in later rounds, near any bad quad met).
         const size_t before = places.size();
         const std::vector<GridRefinement> kept_places = places;
-        blame(pass, places);
+        blamed = blame(pass, places);
         places.erase(std::remove_if(places.begin(), places.end(), [&](const GridRefinement& r) { return is_blocked(r.point); }),
                      places.end());
         report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
                              " flipped or degenerate quads; again without the " + std::to_string(before - places.size()) +
                              " of its " + std::to_string(before) + " places whose lines run by them");
         // Else, or when that gains no part, the bad pass stays (with the places it was made from).
-        if (before == places.size() || places.empty() || !attempt()) places = kept_places;
+        if (before == places.size() || places.empty() || !attempt())
+          places = kept_places;
+        else
+          blamed = -1;  // a new pass
       }
       if (!refined) {  // the budget is spent
         grid_options.refine_rounds.pop_back();
@@ -335,7 +343,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       if (pass_bad.first > best_bad.first) {
         // Not taken; the next round refines elsewhere (no place near the ones blamed). With none
         // blamed it would make the same grid: the end.
-        const int blamed = blame(pass, grid_options.refine_rounds.back());
+        if (blamed < 0) blamed = blame(pass, grid_options.refine_rounds.back());
         grid_options.refine_rounds.pop_back();
         if (blamed == 0 || ++without_gain == 2) break;
         continue;
