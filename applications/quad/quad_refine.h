@@ -47,6 +47,10 @@ struct QuadRefineOptions {
   // A warm round relaxes only the vertices of quads with a new corner and of this many rings of
   // quads round them; the others keep their places. -1: every vertex relaxes.
   int local_rings = 2;
+  // After refinement rounds were kept, this many relaxation sweeps of every vertex (fitted ones
+  // held), kept only if the quads then flip nothing more and miss the model no farther or within
+  // 0.9 × bound_percent; 0: none.
+  int polish_sweeps = 15;
   // Threads for the distance queries and the map's values at P's vertices (the map must then be
   // thread-safe); 0: one per hardware thread, 1: the calling thread.
   int threads = 1;

@@ -361,6 +361,24 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         break;
       }
     }
+    if (result.refine_rounds > 0 && options.refine.polish_sweeps > 0 && options.smooth.sweeps > 0) {
+      // The kept rounds relaxed only round their lines: all of it once more (fitted corners held),
+      // kept if it flips nothing more and misses the model no farther, or within the bound's aim.
+      QuadSmoothOptions polish = options.smooth;
+      polish.sweeps = std::min(options.refine.polish_sweeps, options.smooth.sweeps);
+      QuadSmoothResult polished = smooth_quads(result.mesh, model, polish, result.fitting.pinned);
+      QuadRemeshResult trial;
+      trial.grid = result.grid;
+      trial.mesh = std::move(polished.mesh);
+      const QuadMiss after = find_quad_misses(trial.grid, trial.mesh, model, locator, goal, trial.grid.cell_size, options.refine.threads);
+      const bool kept = (after.farthest <= result.refine_miss_after || after.farthest <= bound) && bad(trial).first <= best_bad.first;
+      report("refine", std::string("a last relaxation of every vertex: ") + (kept ? "kept" : "not kept") + " (misses by up to " +
+                           format("%.3f %%", 100 * after.farthest / diagonal) + ")");
+      if (kept) {
+        result.mesh = std::move(trial.mesh);
+        result.refine_miss_after = after.farthest;
+      }
+    }
     result.seconds_refine = since(begin);
     report("refine", std::to_string(result.refine_rounds) + " rounds kept, " + std::to_string(result.grid.refined_parts) +
                          " chord parts halved, " + std::to_string(result.grid.mesh.num_quads()) + " quads, farthest miss " +

@@ -426,6 +426,27 @@ TEST(QuadCarry, RefinedGridKeepsTheFinishedPlaces) {
 
 // A refined grid keeps the lines of the grid it refines: every vertex of the coarse grid is a vertex
 // of the refined one, found at its place; the added vertices match none.
+// After kept refinement rounds, a last relaxation of every vertex: kept only if it flips nothing
+// more and misses the model no farther (or within 0.9 x the bound); on the horn it evens the
+// angles the local rounds left round their lines.
+TEST(QuadCarry, LastRelaxationAfterTheRounds) {
+  const HornedSphere& h = horned_sphere();
+  QuadRemeshOptions options = horn_options(1500, 3);
+  options.refine.max_growth = 2;
+  options.refine.polish_sweeps = 0;
+  const QuadRemeshResult rough = remesh_quads(h.P, h.radial, *h.model, options);
+  options.refine.polish_sweeps = 15;
+  const QuadRemeshResult polished = remesh_quads(h.P, h.radial, *h.model, options);
+  ASSERT_GT(rough.refine_rounds, 0);
+  EXPECT_EQ(polished.mesh.Q, rough.mesh.Q) << "the same rounds, then only vertices move";
+  EXPECT_NE(polished.mesh.V, rough.mesh.V) << "kept on the horn";
+  EXPECT_LE(polished.refine_miss_after,
+            std::max(rough.refine_miss_after, 0.9 * options.refine.bound_percent / 100 * polished.quality.diagonal));
+  EXPECT_LE(polished.quality.flipped_quads, rough.quality.flipped_quads);
+  EXPECT_LT(polished.quality.angle_deviation_mean, rough.quality.angle_deviation_mean);
+  EXPECT_LE(polished.quality.max_distance_to_surface, 1e-9 * polished.quality.diagonal);
+}
+
 // The misses of uniform quads on the horned sphere: each missed model point comes with two places
 // on P, its preimage through the chords and the point of P under the quads' closest point to it
 // (its image through the quads is that closest point, at the miss's distance from a model point).
