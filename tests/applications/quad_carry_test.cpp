@@ -285,17 +285,19 @@ QuadRemeshOptions horn_options(int quads, int rounds) {
   return options;
 }
 
-TEST(QuadCarry, RefinementReachesIntoAHorn) {
+// The horned sphere's quads with these options.
+QuadRemeshResult remesh_horn(const QuadRemeshOptions& options) {
   const HornedSphere& h = horned_sphere();
-  const TriMesh& P = h.P;
-  const auto& model = h.model;
-  const SurfaceMap& radial = h.radial;
+  return remesh_quads(h.P, h.radial, *h.model, options);
+}
+
+TEST(QuadCarry, RefinementReachesIntoAHorn) {
   QuadRemeshOptions options = horn_options(1500, 0);
-  const QuadRemeshResult uniform = remesh_quads(P, radial, *model, options);
+  const QuadRemeshResult uniform = remesh_horn(options);
   options.refine.rounds = 4;
   options.refine.max_growth = 2;  // lines run round the whole cube: this horn needs many
   options.refine.bound_percent = 0;  // the rounds and budget above only (the bound: below)
-  const QuadRemeshResult refined = remesh_quads(P, radial, *model, options);
+  const QuadRemeshResult refined = remesh_horn(options);
 
   EXPECT_EQ(uniform.refine_rounds, 0);
   EXPECT_EQ(uniform.grid.refined_parts, 0);
@@ -320,14 +322,13 @@ TEST(QuadCarry, RefinementReachesIntoAHorn) {
 // than refine.bound_percent, the refinement goes on (more rounds, a budget of bound_growth), and
 // stops once within it.
 TEST(QuadCarry, RefinementGoesOnToTheBound) {
-  const HornedSphere& h = horned_sphere();
   QuadRemeshOptions options = horn_options(1500, 1);
   options.refine.max_growth = 1.1;
   options.refine.bound_percent = 0;
-  const QuadRemeshResult short_budget = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult short_budget = remesh_horn(options);
   options.refine.bound_percent = 0.5;
   options.refine.bound_growth = 3;
-  const QuadRemeshResult bounded = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult bounded = remesh_horn(options);
   const double diagonal = bounded.quality.diagonal;
   ASSERT_GT(short_budget.refine_miss_after, 0.005 * diagonal) << "the short budget leaves the horn beyond the bound";
   EXPECT_GT(bounded.refine_rounds, 1) << "rounds past refine.rounds";
@@ -343,11 +344,10 @@ TEST(QuadCarry, RefinementGoesOnToTheBound) {
 // refines, away from quads with a new corner (more than refine.local_rings rings), keep their
 // places exactly; with local_rings -1 the relaxation moves them too.
 TEST(QuadCarry, WarmRoundRelaxesOnlyRoundTheAddedLines) {
-  const HornedSphere& h = horned_sphere();
   QuadRemeshOptions options = horn_options(1500, 0);
   options.fit.passes = 0;
   options.untangle.passes = 0;
-  const QuadRemeshResult uniform = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult uniform = remesh_horn(options);
   options.refine.rounds = 1;
   options.refine.bound_percent = 0;
   const auto kept_far_from_new_quads = [&](const QuadRemeshResult& r, int rings, int& far) {
@@ -373,13 +373,13 @@ TEST(QuadCarry, WarmRoundRelaxesOnlyRoundTheAddedLines) {
     }
     return kept;
   };
-  const QuadRemeshResult local = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult local = remesh_horn(options);
   ASSERT_EQ(local.refine_rounds, 1);
   int far = 0;
   EXPECT_EQ(kept_far_from_new_quads(local, options.refine.local_rings, far), far);
   EXPECT_GT(far, uniform.mesh.num_vertices() / 2) << "most of the grid is away from the horn's lines";
   options.refine.local_rings = -1;
-  const QuadRemeshResult everywhere = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult everywhere = remesh_horn(options);
   ASSERT_EQ(everywhere.refine_rounds, 1);
   EXPECT_LT(kept_far_from_new_quads(everywhere, 2, far), far / 2);
 }
@@ -390,7 +390,7 @@ TEST(QuadCarry, WarmRoundRelaxesOnlyRoundTheAddedLines) {
 TEST(QuadCarry, RefinedGridKeepsTheFinishedPlaces) {
   const HornedSphere& h = horned_sphere();
   QuadRemeshOptions options = horn_options(600, 0);
-  const QuadRemeshResult r = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult r = remesh_horn(options);
   PolycubeGridOptions finer = options.grid;
   finer.refine_rounds = {{GridRefinement{r.grid.on_polycube[0], 1}}};
   const PolycubeGrid refined = build_polycube_grid(h.P, finer);
@@ -430,13 +430,12 @@ TEST(QuadCarry, RefinedGridKeepsTheFinishedPlaces) {
 // more and misses the model no farther (or within 0.9 x the bound); on the horn it evens the
 // angles the local rounds left round their lines.
 TEST(QuadCarry, LastRelaxationAfterTheRounds) {
-  const HornedSphere& h = horned_sphere();
   QuadRemeshOptions options = horn_options(1500, 3);
   options.refine.max_growth = 2;
   options.refine.polish_sweeps = 0;
-  const QuadRemeshResult rough = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult rough = remesh_horn(options);
   options.refine.polish_sweeps = 15;
-  const QuadRemeshResult polished = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult polished = remesh_horn(options);
   ASSERT_GT(rough.refine_rounds, 0);
   EXPECT_EQ(polished.mesh.Q, rough.mesh.Q) << "the same rounds, then only vertices move";
   EXPECT_NE(polished.mesh.V, rough.mesh.V) << "kept on the horn";
@@ -453,7 +452,7 @@ TEST(QuadCarry, LastRelaxationAfterTheRounds) {
 TEST(QuadCarry, MissesComeWithThePlaceUnderTheQuads) {
   const HornedSphere& h = horned_sphere();
   QuadRemeshOptions options = horn_options(1500, 0);
-  const QuadRemeshResult r = remesh_quads(h.P, h.radial, *h.model, options);
+  const QuadRemeshResult r = remesh_horn(options);
   const PreimageLocator locator(h.P, h.radial, 1);
   const double diagonal = r.quality.diagonal;
   const QuadMiss miss = find_quad_misses(r.grid, r.mesh, *h.model, locator, 0.0025 * diagonal, r.grid.cell_size, 1);
