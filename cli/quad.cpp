@@ -438,7 +438,7 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
       ->check(CLI::Range(1.0, 100.0));
   command->add_option("--refine-bound", options->refine_bound,
                       "While the quads still miss the model by more than this % of the diagonal, the refinement goes on past "
-                      "--refine and --refine-growth (up to 4 more rounds, up to --refine-bound-growth times the quads; 0: never)")
+                      "--refine and --refine-growth (up to 8 more rounds, up to --refine-bound-growth times the quads; 0: never)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 100.0));
   command->add_option("--refine-bound-growth", options->refine_bound_growth,
