@@ -187,10 +187,12 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     grid_options.refine_max_quads = static_cast<long long>(options.refine.max_growth * base_quads);
     QuadQualityOptions topology_only = options.quality;
     topology_only.hausdorff = false;
-    const auto bad = [&](const QuadRemeshResult& r) {
-      const QuadQuality q = measure_quads(r.mesh, model, r.grid.corners, topology_only);
+    // (flipped + degenerate quads, inverted corners) of quads on the grid's connectivity.
+    const auto bad_of = [&](const QuadMesh& quads, const PolycubeGrid& grid) {
+      const QuadQuality q = measure_quads(quads, model, grid.corners, topology_only);
       return std::make_pair(q.flipped_quads + q.degenerate_quads, q.inverted_corners);
     };
+    const auto bad = [&](const QuadRemeshResult& r) { return bad_of(r.mesh, r.grid); };
     auto best_bad = bad(result);
     QuadMiss miss = find_quad_misses(result.grid, result.mesh, model, locator, goal, result.grid.cell_size, options.refine.threads);
     result.refine_miss_before = result.refine_miss_after = miss.farthest;
@@ -367,15 +369,14 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       QuadSmoothOptions polish = options.smooth;
       polish.sweeps = std::min(options.refine.polish_sweeps, options.smooth.sweeps);
       QuadSmoothResult polished = smooth_quads(result.mesh, model, polish, result.fitting.pinned);
-      QuadRemeshResult trial;
-      trial.grid = result.grid;
-      trial.mesh = std::move(polished.mesh);
-      const QuadMiss after = find_quad_misses(trial.grid, trial.mesh, model, locator, goal, trial.grid.cell_size, options.refine.threads);
-      const bool kept = (after.farthest <= result.refine_miss_after || after.farthest <= bound) && bad(trial).first <= best_bad.first;
+      const QuadMiss after =
+          find_quad_misses(result.grid, polished.mesh, model, locator, goal, result.grid.cell_size, options.refine.threads);
+      const bool kept = (after.farthest <= result.refine_miss_after || after.farthest <= bound) &&
+                        bad_of(polished.mesh, result.grid).first <= best_bad.first;
       report("refine", std::string("a last relaxation of every vertex: ") + (kept ? "kept" : "not kept") + " (misses by up to " +
                            format("%.3f %%", 100 * after.farthest / diagonal) + ")");
       if (kept) {
-        result.mesh = std::move(trial.mesh);
+        result.mesh = std::move(polished.mesh);
         result.refine_miss_after = after.farthest;
       }
     }

@@ -655,13 +655,13 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     return n;
   };
   result.flipped_before = result.flipped_after = count_flipped();
-  const auto sum_over = [&](int v, const std::vector<std::pair<int, int>>& of) {
-    std::pair<int, int> sum{0, 0};
-    for (size_t i = 0; i < around[v].size(); ++i) {
-      sum.first += of[i].first;
-      sum.second += of[i].second;
+  const auto sum = [](const std::vector<std::pair<int, int>>& of) {
+    std::pair<int, int> total{0, 0};
+    for (const auto& [flipped, inverted] : of) {
+      total.first += flipped;
+      total.second += inverted;
     }
-    return sum;
+    return total;
   };
   std::vector<std::pair<int, int>> before, after;
   std::vector<Eigen::Vector3d> targets;
@@ -670,7 +670,7 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     if ((!pinned.empty() && pinned[v]) || neighbours[v].empty()) return false;
     before.clear();
     for (int q : around[v]) before.push_back(state[q]);
-    const std::pair<int, int> was = sum_over(v, before);
+    const std::pair<int, int> was = sum(before);
     if (was.first == 0 && was.second == 0) return false;
     const Eigen::Vector3d p = mesh.V.row(v);
     const SurfaceHit here = surface.closest(p);
@@ -696,7 +696,7 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
         mesh.V.row(v) = hit.point.transpose();
         after.clear();
         for (int q : around[v]) after.push_back(badness(q));
-        if (sum_over(v, after) < was) {
+        if (sum(after) < was) {
           for (size_t i = 0; i < around[v].size(); ++i) state[around[v][i]] = after[i];
           ++result.moves;
           return true;
