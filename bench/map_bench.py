@@ -93,7 +93,7 @@ def main():
         p = paper.get(key)
         paper_cols = "%s / %s / %s min" % (p["eps_angle"], p["eps_area"], p["minutes"]) if p else ""
         if r is None:
-            rows.append("| %s | | | | | | | | | | %.2f | %.0f | failed (exit %d): %s | %s |" % (name, wall, rss, code, error.replace("|", "/"), paper_cols))
+            rows.append("| %s | | | | | | | | | | | %.2f | %.0f | failed (exit %d): %s | %s |" % (name, wall, rss, code, error.replace("|", "/"), paper_cols))
             print(name, "failed", error, file=sys.stderr)
             continue
         m = r.get("map", {})
@@ -103,21 +103,26 @@ def main():
         smooth = s.get("smooth", 0) + s.get("smooth_unrefined", 0)
         # retry: the other orientation candidates finished because the first map fell short.
         stages = " / ".join("%.2f" % x for x in (s.get("align", 0), s.get("topology", 0), s.get("polycube", 0), s.get("map", 0),
-                                                  s.get("refine", 0), smooth, s.get("retry", 0)))
+                                                  s.get("refine", 0), smooth, s.get("untangle", 0), s.get("retry", 0)))
+        # The last untangling of the files (image_untangle.h): images moved, largest shift.
+        u = m.get("untangling") or {}
+        moved = sum(u.get(d, {}).get("moved", 0) for d in ("polycube_to_model", "model_to_polycube"))
+        shift = max([u.get(d, {}).get("max_shift", 0) for d in ("polycube_to_model", "model_to_polycube")])
+        untangled = "%d, %.2f %%" % (moved, 100 * shift) if moved else "–"
         pm, mp = m.get("polycube_to_model", {}), m.get("model_to_polycube", {})
         # Degenerate image triangles (area <= 1e-14 of the target's) are counted apart by the audit.
         flips = "%d / %d" % (pm.get("flipped", -1), mp.get("flipped", -1))
         if pm.get("degenerate", 0) or mp.get("degenerate", 0):
             flips += " (+ %d / %d degenerate)" % (pm.get("degenerate", 0), mp.get("degenerate", 0))
-        rows.append("| %s | %d | %d | %s | %s | %d | %.3f | %.3f | %s | %.4f | %s | %.2f | %.0f | %s | %s |" % (
+        rows.append("| %s | %d | %d | %s | %s | %d | %.3f | %.3f | %s | %.4f | %s | %s | %.2f | %.0f | %s | %s |" % (
             name, r["input"]["faces"], r["input"]["genus"], r["parameters"]["dz"], r["parameters"]["da"],
             r["polycube"]["corners"], m.get("eps_angle", float("nan")), m.get("eps_area", float("nan")),
-            flips, pm.get("area_ratio", float("nan")), stages, s["total"], rss,
+            flips, pm.get("area_ratio", float("nan")), untangled, stages, s["total"], rss,
             "ok" if len(r.get("alignment", {}).get("finished", [])) < 2 else "ok, %d finished" % len(r["alignment"]["finished"]), paper_cols))
         print(rows[-1], file=sys.stderr)
     header = [
-        "| mesh | triangles | genus | d_z | d_a | corners | ε_angle | ε_area | flipped P→M / M→P | image area / model area | seconds align / topology / polycube / map / refine / smooth / retry | total s | peak RSS MB | result | paper ε_angle / ε_area / time |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| mesh | triangles | genus | d_z | d_a | corners | ε_angle | ε_area | flipped P→M / M→P | image area / model area | images moved, largest shift (% of diagonal) | seconds align / topology / polycube / map / refine / smooth / untangle / retry | total s | peak RSS MB | result | paper ε_angle / ε_area / time |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     with open(a.output, "w") as f:
         f.write("\n".join(header + rows) + "\n")

@@ -9,6 +9,7 @@
 #include "formats/mesh_io.h"
 #include "polycube/align.h"
 #include "polycube/errors.h"
+#include "polycube/image_untangle.h"
 #include "polycube/polycube_build.h"
 #include "polycube/map_audit.h"
 #include "polycube/map_quality.h"
@@ -45,6 +46,8 @@ struct MapOptions {
   std::string align = "auto";
   int smooth_sweeps = 10;
   bool refine = true;
+  // The last untangling's largest move of an image, × the target's diagonal; 0: none.
+  double untangle_shift = ImageUntangleOptions().max_shift;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -120,8 +123,8 @@ struct Finished {
   const Polycube* polycube = nullptr;
   std::unique_ptr<MapRefinementResult> resampling;
   Eigen::MatrixX3d on_model_xyz, on_polycube_xyz;
-  nlohmann::json smoothing = nullptr, resampling_report = nullptr;
-  double smooth_seconds = 0, resample_seconds = 0;
+  nlohmann::json smoothing = nullptr, resampling_report = nullptr, untangling = nullptr;
+  double smooth_seconds = 0, resample_seconds = 0, untangle_seconds = 0;
   MapAudit audit;
   int bad_p() const { return audit.polycube_to_model.flipped + audit.polycube_to_model.degenerate; }
   int bad_m() const { return audit.model_to_polycube.flipped + audit.model_to_polycube.degenerate; }
@@ -204,6 +207,32 @@ std::string refinement_line(const MapRefinementResult& r) {
   return line.str();
 }
 
+// The last correction of the files (image_untangle.h): where an image triangle of either
+// direction is still flipped or degenerate, single vertex images move on the target surface until
+// the audit passes there; then the audit again.
+void untangle_images(const TriMesh& model, Finished& out, double max_shift, const Progress& progress) {
+  if ((out.bad_p() == 0 && out.bad_m() == 0) || max_shift <= 0) return;
+  const double start = progress.elapsed_seconds();
+  progress.stage("untangle", std::to_string(out.bad_p()) + " / " + std::to_string(out.bad_m()) +
+                                 " bad image triangles (P to M / M to P): moving single images");
+  const TriMesh& P = out.polycube->mesh;
+  ImageUntangleOptions options;
+  options.max_shift = max_shift;
+  auto run = [&options](const TriMesh& source, Eigen::MatrixX3d& image, const TriMesh& target) {
+    const ImageUntangleResult result = untangle_image(source, image, target, options);
+    image = result.image;
+    return nlohmann::json{{"bad_before", result.bad_before}, {"bad_after", result.bad_after},
+                          {"moved", result.moved}, {"max_shift", result.max_shift}};
+  };
+  out.untangling = nlohmann::json::object();
+  if (out.bad_p() > 0) out.untangling["polycube_to_model"] = run(P, out.on_model_xyz, model);
+  if (out.bad_m() > 0) out.untangling["model_to_polycube"] = run(model, out.on_polycube_xyz, P);
+  out.audit = audit_map(model, P, out.on_model_xyz, out.on_polycube_xyz);
+  out.untangle_seconds = progress.elapsed_seconds() - start;
+  out.untangling["seconds"] = out.untangle_seconds;
+  progress.stage("untangle", std::to_string(out.bad_p()) + " / " + std::to_string(out.bad_m()) + " left");
+}
+
 // Stage 5 (§3.5) on a given P and sampling: the smoothing, which never adds a flip in either
 // direction, then the second refinement of P's sampling; the audit of the result.
 std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<double>& planes_z, const Polycube& P,
@@ -263,6 +292,7 @@ std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<dou
     }
   }
   out->audit = audit_map(model, out->polycube->mesh, out->on_model_xyz, out->on_polycube_xyz);
+  untangle_images(model, *out, options.untangle_shift, progress);
   return out;
 }
 
@@ -346,6 +376,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   report["input"]["file"] = options.input.path;
   report["parameters"] = {{"dz", options.topology.dz}, {"da", options.polycube.da}, {"stage", options.stage}};
   report["parameters"]["align"] = options.align;
+  report["parameters"]["untangle_shift"] = options.untangle_shift;
   std::vector<std::string> outputs;
 
   // The pipeline runs on the model turned into the chosen frame; outputs go back to the input's.
@@ -480,6 +511,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     if (options.refine) seconds["refine"] = chosen.refine_seconds;
     if (chosen.smooth_unrefined_seconds > 0) seconds["smooth_unrefined"] = chosen.smooth_unrefined_seconds;
     if (options.smooth_sweeps > 0) seconds["smooth"] = finished.smooth_seconds;
+    if (finished.untangle_seconds > 0) seconds["untangle"] = finished.untangle_seconds;
     written_polycube = finished.polycube;
     const Polycube& P = *written_polycube;
     on_polycube_xyz = finished.on_polycube_xyz;
@@ -506,7 +538,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"area_p95", audit.distortion.area_p95},
                      {"area_max", audit.distortion.area_max},
                      {"refinement", chosen.refinement_report},
-                     {"smoothing", finished.smoothing}};
+                     {"smoothing", finished.smoothing},
+                     {"untangling", finished.untangling}};
     TriMesh on_model = P.mesh;
     on_model.V = to_input(finished.on_model_xyz);
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
@@ -575,6 +608,11 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
       ->check(CLI::Range(0, 1000));
   command->add_flag("--no-refine{false}", options->refine,
                    "Keep P's triangulation as built: do not refine it where the map sampled at its vertices flips or loses area");
+  command->add_option("--untangle-shift", options->untangle_shift,
+                      "Where an image triangle of the finished map is still flipped, move single vertex images on the other "
+                      "surface by at most this fraction of its bounding-box diagonal to unfold it; 0: write the sampled map as is")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.1));
   command->add_option("--stage", options->stage, "Stop after this stage")
       ->capture_default_str()
       ->check(CLI::IsMember(kStages));

@@ -2,7 +2,7 @@
 
 #include "polycube/image_orientation.h"
 
-#include "polycube/triangle_tree.h"
+#include "polycube/target_surface.h"
 
 #include <Eigen/Geometry>
 
@@ -17,18 +17,7 @@ namespace polycube {
 
 namespace {
 
-using namespace triangle_tree;
-
-// Image triangles at or below this fraction of the target area are degenerate.
-constexpr double kDegenerateArea = 1e-14;
-
 Eigen::Vector3d row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpose(); }
-
-// Area vector (twice the area along the unit normal) of face f of mesh.
-Eigen::Vector3d face_area_vector(const TriMesh& mesh, int f) {
-  const Eigen::Vector3d a = row(mesh.V, mesh.F(f, 0));
-  return (row(mesh.V, mesh.F(f, 1)) - a).cross(row(mesh.V, mesh.F(f, 2)) - a);
-}
 
 void check_faces(const TriMesh& mesh, int vertices, const char* what) {
   if (mesh.num_faces() == 0) throw std::invalid_argument(std::string("audit_map: ") + what + " has no faces");
@@ -36,47 +25,6 @@ void check_faces(const TriMesh& mesh, int vertices, const char* what) {
     throw std::invalid_argument(std::string("audit_map: ") + what + " has a face index out of range [0, " +
                                 std::to_string(vertices) + ")");
 }
-
-// Closest points on the target surface. Faces of exactly zero area are left out of the tree
-// (their points lie on a neighbour's edge in a closed mesh, and they have no normal).
-class TargetSurface {
- public:
-  explicit TargetSurface(const TriMesh& target) {
-    triangles_.reserve(target.num_faces());
-    for (int f = 0; f < target.num_faces(); ++f) {
-      area_vectors_.push_back(face_area_vector(target, f));
-      if (area_vectors_.back().squaredNorm() == 0) continue;
-      auto point = [&](int c) {
-        const int v = target.F(f, c);
-        return Point(target.V(v, 0), target.V(v, 1), target.V(v, 2));
-      };
-      triangles_.emplace_back(point(0), point(1), point(2));
-      faces_.push_back(f);
-    }
-    if (triangles_.empty()) throw std::invalid_argument("audit_map: target has zero area");
-    tree_.rebuild(triangles_.begin(), triangles_.end());
-    tree_.accelerate_distance_queries();
-  }
-  TargetSurface(const TargetSurface&) = delete;
-  TargetSurface& operator=(const TargetSurface&) = delete;
-
-  // Closest target face to p and the distance to it.
-  std::pair<int, double> closest(const Eigen::Vector3d& p) const {
-    const Point query(p.x(), p.y(), p.z());
-    const auto [point, id] = tree_.closest_point_and_primitive(query);
-    const int face = faces_[static_cast<size_t>(id - triangles_.begin())];
-    return {face, std::sqrt(CGAL::squared_distance(query, point))};
-  }
-
-  // Per target face: twice the area times the outward unit normal.
-  const std::vector<Eigen::Vector3d>& area_vectors() const { return area_vectors_; }
-
- private:
-  std::vector<Eigen::Vector3d> area_vectors_;
-  std::vector<Triangle> triangles_;
-  std::vector<int> faces_;  // target face of each tree triangle
-  Tree tree_;
-};
 
 }  // namespace
 
@@ -95,7 +43,7 @@ MapDirectionAudit audit_map_direction(const TriMesh& source, const Eigen::Matrix
   check_faces(target, target.num_vertices(), "target");
   if (!target.V.allFinite()) throw std::invalid_argument("audit_map: target has non-finite vertices");
 
-  const TargetSurface surface(target);
+  const TargetSurface surface(target, "audit_map");
   const double target_area = surface_area(target);
   const double diagonal = bounding_box(target.V).diagonal();
 
@@ -124,7 +72,7 @@ MapDirectionAudit audit_map_direction(const TriMesh& source, const Eigen::Matrix
     const Eigen::Vector3d normal = (b - a).cross(c - a);
     const double area = 0.5 * normal.norm();
     image_area += area;
-    if (area <= kDegenerateArea * target_area) {
+    if (area <= kAuditDegenerateArea * target_area) {
       ++audit.degenerate;
       continue;
     }

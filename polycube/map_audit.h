@@ -11,6 +11,9 @@
 
 namespace polycube {
 
+// Image triangles with an area at or below this fraction of the target's area are degenerate.
+inline constexpr double kAuditDegenerateArea = 1e-14;
+
 struct MapAuditOptions {
   // Largest accepted distance of an image vertex from the target surface, × the target's
   // bounding-box diagonal.

@@ -1,0 +1,327 @@
+#include "polycube/image_untangle.h"
+
+#include "polycube/image_orientation.h"
+#include "polycube/map_audit.h"
+#include "polycube/target_surface.h"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace polycube {
+
+namespace {
+
+// Ring radii, as fractions of the vertex's shortest image edge, and directions per ring.
+constexpr std::array<double, 9> kRings = {0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5, 2.0};
+constexpr int kDirections = 16;
+// Rings farther than this many times the best shift found so far are not tried.
+constexpr double kRingSlack = 1.5;
+// The second kind of sweep moves the vertices within this many edges of a bad triangle.
+constexpr int kOptimiseRings = 2;
+// ... and only those whose smallest signed fan area is below this fraction of the fan's mean.
+constexpr double kSqueezedFan = 0.25;
+
+class Untangler {
+ public:
+  Untangler(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target)
+      : source_(source), surface_(target, "untangle_image"), image_(image), face_(source.num_vertices()),
+        star_(source.num_vertices()), bad_(source.num_faces()) {
+    degenerate_area_ = kAuditDegenerateArea * surface_area(target);
+    for (int v = 0; v < source.num_vertices(); ++v) face_[v] = surface_.closest(point(v)).first;
+    for (int f = 0; f < source.num_faces(); ++f) {
+      for (int c = 0; c < 3; ++c) star_[source.F(f, c)].push_back(f);
+      bad_[f] = judge(f);
+    }
+  }
+
+  int bad_count() const { return static_cast<int>(std::count(bad_.begin(), bad_.end(), true)); }
+  const Eigen::MatrixX3d& image() const { return image_; }
+
+  // One sweep of the second kind (see the header): every vertex within kOptimiseRings of a bad
+  // triangle moves towards the point of its tangent plane where the smallest signed area of its
+  // fan is largest; returns whether any vertex moved.
+  bool optimise(const Eigen::MatrixX3d& input, double max_shift) {
+    bool moved = false;
+    for (int v : near_bad()) {
+      const std::optional<Move> move = fan_move(v, input, max_shift);
+      if (!move) continue;
+      place(move->vertex, move->point, move->face);
+      moved = true;
+    }
+    return moved;
+  }
+
+  // One sweep over the triangles still bad; returns whether any vertex moved.
+  bool sweep(const Eigen::MatrixX3d& input, double max_shift) {
+    bool moved = false;
+    for (int f = 0; f < source_.num_faces(); ++f) {
+      if (!bad_[f]) continue;
+      std::optional<Move> best;
+      for (int c = 0; c < 3; ++c) {
+        const std::optional<Move> move = best_move(source_.F(f, c), input, max_shift, best ? best->shift : kInfinity);
+        if (move && (!best || move->shift < best->shift)) best = move;
+      }
+      if (!best) continue;
+      place(best->vertex, best->point, best->face);
+      moved = true;
+    }
+    return moved;
+  }
+
+ private:
+  static constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+  struct Move {
+    int vertex;
+    Eigen::Vector3d point;
+    int face;
+    double shift;
+  };
+
+  Eigen::Vector3d point(int v) const { return image_.row(v).transpose(); }
+
+  // The vertices within kOptimiseRings edges of a bad triangle, in index order.
+  std::vector<int> near_bad() const {
+    std::vector<int> depth(source_.num_vertices(), -1), frontier;
+    for (int f = 0; f < source_.num_faces(); ++f)
+      if (bad_[f])
+        for (int c = 0; c < 3; ++c)
+          if (int v = source_.F(f, c); depth[v] < 0) depth[v] = 0, frontier.push_back(v);
+    for (int ring = 1; ring <= kOptimiseRings; ++ring) {
+      std::vector<int> next;
+      for (int v : frontier)
+        for (int f : star_[v])
+          for (int c = 0; c < 3; ++c)
+            if (int w = source_.F(f, c); depth[w] < 0) depth[w] = ring, next.push_back(w);
+      frontier = std::move(next);
+    }
+    std::vector<int> vertices;
+    for (int v = 0; v < source_.num_vertices(); ++v)
+      if (depth[v] >= 0) vertices.push_back(v);
+    return vertices;
+  }
+
+  // The signed areas of v's fan with v at p, in the plane of `normal`: each triangle (p, q, r)
+  // in the source's orientation gives ½ normal · ((q − p) × (r − p)).
+  double smallest_fan_area(int v, const Eigen::Vector3d& p, const Eigen::Vector3d& normal) const {
+    double smallest = kInfinity;
+    for (int f : star_[v]) {
+      const int k = source_.F(f, 0) == v ? 0 : (source_.F(f, 1) == v ? 1 : 2);
+      const Eigen::Vector3d q = point(source_.F(f, (k + 1) % 3)), r = point(source_.F(f, (k + 2) % 3));
+      smallest = std::min(smallest, 0.5 * normal.dot((q - p).cross(r - p)));
+    }
+    return smallest;
+  }
+
+  // The point p = old + x u + y w, |x|, |y| <= radius, where the smallest fan area is largest:
+  // each fan area is linear in (x, y), so the optimum of their minimum over the square is a
+  // corner, a point of a side where two areas are equal, or a point where three are.
+  Eigen::Vector2d widest_fan_point(int v, const Eigen::Vector3d& old, const Eigen::Vector3d& normal, const Eigen::Vector3d& u,
+                                   const Eigen::Vector3d& w, double radius) const {
+    std::vector<Eigen::Vector3d> lines;  // area = l.x x + l.y y + l.z
+    for (int f : star_[v]) {
+      const int k = source_.F(f, 0) == v ? 0 : (source_.F(f, 1) == v ? 1 : 2);
+      const Eigen::Vector3d q = point(source_.F(f, (k + 1) % 3)), r = point(source_.F(f, (k + 2) % 3));
+      auto area = [&](const Eigen::Vector3d& p) { return 0.5 * normal.dot((q - p).cross(r - p)); };
+      const double at = area(old);
+      lines.emplace_back(area(old + u) - at, area(old + w) - at, at);
+    }
+    auto smallest = [&](const Eigen::Vector2d& x) {
+      double m = kInfinity;
+      for (const Eigen::Vector3d& l : lines) m = std::min(m, l.x() * x.x() + l.y() * x.y() + l.z());
+      return m;
+    };
+    Eigen::Vector2d best(0, 0);
+    double best_value = smallest(best);
+    auto consider = [&](const Eigen::Vector2d& x) {
+      if (!x.allFinite() || std::abs(x.x()) > radius * (1 + 1e-12) || std::abs(x.y()) > radius * (1 + 1e-12)) return;
+      if (const double value = smallest(x); value > best_value) best = x, best_value = value;
+    };
+    for (int sx : {-1, 1})
+      for (int sy : {-1, 1}) consider(Eigen::Vector2d(sx * radius, sy * radius));
+    const int n = static_cast<int>(lines.size());
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) {
+        const Eigen::Vector3d d = lines[i] - lines[j];  // d.x x + d.y y + d.z = 0 on the tie
+        for (int side : {-1, 1}) {
+          if (d.y() != 0) consider(Eigen::Vector2d(side * radius, -(d.z() + d.x() * side * radius) / d.y()));
+          if (d.x() != 0) consider(Eigen::Vector2d(-(d.z() + d.y() * side * radius) / d.x(), side * radius));
+        }
+        for (int k = j + 1; k < n; ++k) {
+          const Eigen::Vector3d e = lines[i] - lines[k];
+          const double det = d.x() * e.y() - d.y() * e.x();
+          if (det != 0) consider(Eigen::Vector2d((-d.z() * e.y() + d.y() * e.z()) / det, (-d.x() * e.z() + d.z() * e.x()) / det));
+        }
+      }
+    return best;
+  }
+
+  // A move of v that raises the smallest signed area of its fan (in the tangent plane of its
+  // closest face) without raising the bad triangles round it or turning a good one bad: towards
+  // the widest-fan point within its shortest image edge, the whole, half or a quarter of the way.
+  std::optional<Move> fan_move(int v, const Eigen::MatrixX3d& input, double max_shift) {
+    const std::vector<int>& star = star_[v];
+    double shortest = kInfinity;
+    for (int f : star)
+      for (int c = 0; c < 3; ++c)
+        if (const int w = source_.F(f, c); w != v) {
+          const double length = (point(w) - point(v)).norm();
+          if (length > 0) shortest = std::min(shortest, length);
+        }
+    if (!std::isfinite(shortest)) return std::nullopt;
+    const Eigen::Vector3d normal = surface_.area_vectors()[face_[v]].normalized();
+    Eigen::Vector3d u = normal.cross(Eigen::Vector3d::UnitX());
+    if (u.norm() < 0.5) u = normal.cross(Eigen::Vector3d::UnitY());
+    u.normalize();
+    const Eigen::Vector3d w = normal.cross(u);
+    const Eigen::Vector3d old = point(v), origin = input.row(v).transpose();
+    const double now = smallest_fan_area(v, old, normal);
+    // Only squeezed fans move: a fan whose smallest area is a fair share of the mean is left.
+    double mean = 0;
+    for (int f : star) {
+      const Eigen::Vector3d a = point(source_.F(f, 0));
+      mean += 0.5 * (point(source_.F(f, 1)) - a).cross(point(source_.F(f, 2)) - a).norm() / star.size();
+    }
+    if (now > kSqueezedFan * mean) return std::nullopt;
+    const Eigen::Vector2d x = widest_fan_point(v, old, normal, u, w, shortest);
+    std::vector<bool> before(star.size());
+    int bad_before = 0;
+    for (size_t k = 0; k < star.size(); ++k) bad_before += before[k] = bad_[star[k]];
+    const int old_face = face_[v];
+    std::optional<Move> found;
+    for (double fraction : {1.0, 0.5, 0.25}) {
+      const Eigen::Vector3d q = surface_.project(old + fraction * (x.x() * u + x.y() * w)).first;
+      if ((q - origin).norm() > max_shift || q == old) continue;
+      // The gain must be real: a relative margin keeps the sweeps from creeping.
+      if (!(smallest_fan_area(v, q, normal) > now + 1e-9 * shortest * shortest)) continue;
+      const int face = surface_.closest(q).first;
+      image_.row(v) = q.transpose();
+      face_[v] = face;
+      int bad_after = 0;
+      bool spoils = false;
+      for (size_t k = 0; k < star.size() && !spoils; ++k) {
+        const bool bad = judge(star[k]);
+        bad_after += bad;
+        spoils = bad && !before[k];
+      }
+      image_.row(v) = old.transpose();
+      face_[v] = old_face;
+      if (!spoils && bad_after <= bad_before) {
+        found = Move{v, q, face, (q - old).norm()};
+        break;
+      }
+    }
+    return found;
+  }
+
+  bool judge(int f) const {
+    const int a = source_.F(f, 0), b = source_.F(f, 1), c = source_.F(f, 2);
+    const Eigen::Vector3d pa = point(a), pb = point(b), pc = point(c);
+    if (0.5 * (pb - pa).cross(pc - pa).norm() <= degenerate_area_) return true;
+    const auto closest = [this](const Eigen::Vector3d& p, int) { return surface_.closest(p).first; };
+    return image_triangle_flipped(pa, pb, pc, face_[a], face_[b], face_[c], surface_.area_vectors(), closest);
+  }
+
+  void place(int v, const Eigen::Vector3d& p, int face) {
+    image_.row(v) = p.transpose();
+    face_[v] = face;
+    for (int f : star_[v]) bad_[f] = judge(f);
+  }
+
+  // The acceptable point round v's image closest to it (not farther than `bound`), if any.
+  std::optional<Move> best_move(int v, const Eigen::MatrixX3d& input, double max_shift, double bound) {
+    const std::vector<int>& star = star_[v];
+    std::vector<bool> before(star.size());
+    int bad_before = 0;
+    for (size_t k = 0; k < star.size(); ++k) bad_before += before[k] = bad_[star[k]];
+    if (bad_before == 0) return std::nullopt;
+    double shortest = kInfinity;
+    for (int f : star)
+      for (int c = 0; c < 3; ++c)
+        if (const int w = source_.F(f, c); w != v) {
+          const double length = (point(w) - point(v)).norm();
+          if (length > 0) shortest = std::min(shortest, length);
+        }
+    if (!std::isfinite(shortest)) return std::nullopt;
+    const Eigen::Vector3d normal = surface_.area_vectors()[face_[v]].normalized();
+    Eigen::Vector3d u = normal.cross(Eigen::Vector3d::UnitX());
+    if (u.norm() < 0.5) u = normal.cross(Eigen::Vector3d::UnitY());
+    u.normalize();
+    const Eigen::Vector3d w = normal.cross(u);
+
+    const Eigen::Vector3d old = point(v), origin = input.row(v).transpose();
+    const int old_face = face_[v];
+    std::optional<Move> best;
+    for (double ring : kRings) {
+      const double radius = ring * shortest;
+      if (radius > kRingSlack * std::min(bound, best ? best->shift : kInfinity)) break;
+      for (int d = 0; d < kDirections; ++d) {
+        const double angle = 2 * M_PI * d / kDirections;
+        const Eigen::Vector3d q = surface_.project(old + radius * (std::cos(angle) * u + std::sin(angle) * w)).first;
+        const double shift = (q - old).norm();
+        if ((q - origin).norm() > max_shift || shift == 0 || (best && shift >= best->shift) || shift >= bound) continue;
+        // The face the audit finds for q (on an edge, the projection's face may be the other one).
+        const int face = surface_.closest(q).first;
+        image_.row(v) = q.transpose();
+        face_[v] = face;
+        int bad_after = 0;
+        bool spoils = false;
+        for (size_t k = 0; k < star.size() && !spoils; ++k) {
+          const bool bad = judge(star[k]);
+          bad_after += bad;
+          spoils = bad && !before[k];
+        }
+        if (!spoils && bad_after < bad_before) best = Move{v, q, face, shift};
+      }
+    }
+    image_.row(v) = old.transpose();
+    face_[v] = old_face;
+    return best;
+  }
+
+  const TriMesh& source_;
+  TargetSurface surface_;
+  Eigen::MatrixX3d image_;
+  std::vector<int> face_;               // closest target face of each image vertex
+  std::vector<std::vector<int>> star_;  // source faces round each vertex
+  std::vector<bool> bad_;               // per source face: flipped or degenerate image
+  double degenerate_area_ = 0;
+};
+
+}  // namespace
+
+ImageUntangleResult untangle_image(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target,
+                                   const ImageUntangleOptions& options) {
+  if (image.rows() != source.num_vertices() || !image.allFinite())
+    throw std::invalid_argument("untangle_image: image needs one finite row per source vertex (" +
+                                std::to_string(source.num_vertices()) + "), got " + std::to_string(image.rows()) + " rows");
+  if (options.sweeps < 0 || !(options.max_shift >= 0))
+    throw std::invalid_argument("untangle_image: sweeps and max_shift must be >= 0");
+  Untangler untangler(source, image, target);
+  ImageUntangleResult result;
+  result.bad_before = untangler.bad_count();
+  const double diagonal = bounding_box(target.V).diagonal();
+  const double max_shift = options.max_shift * diagonal;
+  for (int s = 0; s < options.sweeps && untangler.bad_count() > 0; ++s)
+    if (!untangler.sweep(image, max_shift) && !untangler.optimise(image, max_shift)) break;
+  result.image = untangler.image();
+  result.bad_after = untangler.bad_count();
+  for (int v = 0; v < source.num_vertices(); ++v) {
+    const double shift = (result.image.row(v) - image.row(v)).norm();
+    if (shift > 0) {
+      ++result.moved;
+      result.max_shift = std::max(result.max_shift, diagonal > 0 ? shift / diagonal : shift);
+    }
+  }
+  return result;
+}
+
+}  // namespace polycube

@@ -1,0 +1,62 @@
+// The last step of the map: where the piecewise-linear sampling of a map still folds an image
+// triangle, move single vertex images by the least tried amount, on the target surface, until
+// the audit's test passes.
+//
+// Why. φ is one-to-one in the continuum, but its files are samples: the images of a mesh's
+// vertices, joined by straight chords. Where a source triangle is a sliver, or long against the
+// map's bends (coarse CAD models on a fine P: a model triangle whose three images lie on one
+// face of P, with one corner a hair's breadth across the line through the other two), the
+// chord triangle can face the wrong way although every image is exact. The smoothing's
+// untangling moves images too, but keeps both directions consistent (moving a model vertex's
+// image relocates the P vertices round it), and there a move that unfolds one direction is
+// refused when it folds the other. Here each direction's file is corrected on its own: the
+// images stay points of the target surface, each moved at most `max_shift` of the target's
+// diagonal from where the map put it (reported), so the two files remain inverse to each other
+// to within that distance.
+//
+// Method. While bad triangles (flipped, as audit_map judges them with the same closest faces, or
+// degenerate) remain, for each bad triangle, each of its corners tries points round its image in
+// the tangent plane of its closest target face — on rings of radius 5 %, 10 %, 20 %, 35 %, 50 %,
+// 75 % of its shortest image edge, 16 directions each — projected onto the target (closest
+// point). A point is acceptable if it leaves fewer bad triangles round the vertex and turns none
+// of them from good to bad; of all acceptable points of the three corners the closest to the
+// current image is taken. Every move lowers the number of bad triangles, so the step ends, and
+// it never adds a bad triangle.
+#pragma once
+
+#include "polycube/mesh.h"
+
+#include <Eigen/Core>
+
+namespace polycube {
+
+struct ImageUntangleOptions {
+  // Sweeps over the bad triangles (each sweep tries every one still bad).
+  int sweeps = 20;
+  // Largest distance of a moved image from its input position, × the target's bounding-box
+  // diagonal.
+  double max_shift = 0.01;
+};
+
+// The corrected images and what it took.
+//   image        #V(source) by 3: the input images, moved where a triangle was untangled
+//   bad_before   flipped + degenerate image triangles of the input (as audit_map counts them)
+//   bad_after    the same after the step (<= bad_before)
+//   moved        vertices whose image moved
+//   max_shift    largest distance of a moved image from its input position / target diagonal
+struct ImageUntangleResult {
+  Eigen::MatrixX3d image;
+  int bad_before = 0;
+  int bad_after = 0;
+  int moved = 0;
+  double max_shift = 0;
+};
+
+// Untangles one direction of a map: source's triangles at the positions `image` (points of
+// target) against the closed, outward-oriented surface target.
+// Throws std::invalid_argument when image does not have one finite row per source vertex, for a
+// target without area, or for negative options.
+ImageUntangleResult untangle_image(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target,
+                                   const ImageUntangleOptions& options = {});
+
+}  // namespace polycube

@@ -1,0 +1,37 @@
+#include "polycube/target_surface.h"
+
+#include <Eigen/Geometry>
+
+#include <stdexcept>
+#include <string>
+
+namespace polycube {
+
+using namespace triangle_tree;
+
+TargetSurface::TargetSurface(const TriMesh& target, const char* what) {
+  triangles_.reserve(target.num_faces());
+  for (int f = 0; f < target.num_faces(); ++f) {
+    const Eigen::Vector3d a = target.V.row(target.F(f, 0)).transpose();
+    area_vectors_.push_back((target.V.row(target.F(f, 1)).transpose() - a).cross(target.V.row(target.F(f, 2)).transpose() - a));
+    if (area_vectors_.back().squaredNorm() == 0) continue;
+    triangles_.emplace_back(point(target, target.F(f, 0)), point(target, target.F(f, 1)), point(target, target.F(f, 2)));
+    faces_.push_back(f);
+  }
+  if (triangles_.empty()) throw std::invalid_argument(std::string(what) + ": target has zero area");
+  tree_.rebuild(triangles_.begin(), triangles_.end());
+  tree_.accelerate_distance_queries();
+}
+
+std::pair<int, double> TargetSurface::closest(const Eigen::Vector3d& p) const {
+  const auto [q, face] = project(p);
+  return {face, (q - p).norm()};
+}
+
+std::pair<Eigen::Vector3d, int> TargetSurface::project(const Eigen::Vector3d& p) const {
+  const Point query(p.x(), p.y(), p.z());
+  const auto [point, id] = tree_.closest_point_and_primitive(query);
+  return {Eigen::Vector3d(point.x(), point.y(), point.z()), faces_[static_cast<size_t>(id - triangles_.begin())]};
+}
+
+}  // namespace polycube

@@ -1,0 +1,110 @@
+// untangle_image: the last correction of a map's files, on images whose folds are known by
+// construction (a flat grid with a vertex dragged across its neighbours, a sliver reversed on a
+// flat face), judged by the independent audit.
+#include "polycube/image_untangle.h"
+
+#include "polycube/map_audit.h"
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+namespace polycube {
+namespace {
+
+// An n × n grid of unit squares in the plane z = 0, each split into two triangles facing +z.
+TriMesh flat_grid(int n) {
+  TriMesh grid;
+  grid.V.resize((n + 1) * (n + 1), 3);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) grid.V.row(j * (n + 1) + i) << i, j, 0;
+  grid.F.resize(2 * n * n, 3);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+      grid.F.row(2 * (j * n + i)) << a, b, c;
+      grid.F.row(2 * (j * n + i) + 1) << a, c, d;
+    }
+  return grid;
+}
+
+int vertex(int n, int i, int j) { return j * (n + 1) + i; }
+
+TEST(ImageUntangle, UnfoldsAVertexDraggedAcrossItsNeighbours) {
+  const int n = 10;
+  const TriMesh grid = flat_grid(n);
+  Eigen::MatrixX3d image = grid.V;
+  // The vertex (5, 5) dragged past its right neighbour: its fan folds over.
+  image.row(vertex(n, 5, 5)) << 6.3, 5.2, 0;
+  const MapDirectionAudit folded = audit_map_direction(grid, image, grid);
+  ASSERT_GT(folded.flipped, 0);
+
+  ImageUntangleOptions options;
+  options.max_shift = 0.2;  // the drag was 1.3 / 14.1 of the diagonal
+  const ImageUntangleResult result = untangle_image(grid, image, grid, options);
+  EXPECT_EQ(result.bad_before, folded.flipped + folded.degenerate);
+  EXPECT_EQ(result.bad_after, 0);
+  const MapDirectionAudit audit = audit_map_direction(grid, result.image, grid);
+  EXPECT_EQ(audit.flipped, 0);
+  EXPECT_EQ(audit.degenerate, 0);
+  EXPECT_LT(audit.max_distance, 1e-12);  // the images stay on the target
+  EXPECT_GT(result.moved, 0);
+  EXPECT_LE(result.max_shift, options.max_shift + 1e-12);
+  // Only images near the fold moved: every vertex farther than three rings is where it was.
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      if (std::max(std::abs(i - 5), std::abs(j - 5)) > 3) {
+        EXPECT_EQ(result.image.row(vertex(n, i, j)), image.row(vertex(n, i, j))) << i << " " << j;
+      }
+}
+
+// A sliver whose apex lies a hair's breadth across the line through its other corners (a coarse
+// model's triangle whose three exact images land on one face of P) is unfolded by a move of
+// about that breadth.
+TEST(ImageUntangle, UnfoldsAReversedSliverByASmallMove) {
+  const int n = 8;
+  const TriMesh grid = flat_grid(n);
+  // A fan round (4, 4): squeeze the vertex (5, 4) towards the diagonal (4, 4)–(5, 5) so that the
+  // triangle (4, 4), (5, 4), (5, 5) becomes a sliver, then just across.
+  Eigen::MatrixX3d image = grid.V;
+  image.row(vertex(n, 5, 4)) << 4.5 - 0.01, 4.5 + 0.01, 0;
+  ASSERT_EQ(audit_map_direction(grid, image, grid).flipped, 1);
+  const ImageUntangleResult result = untangle_image(grid, image, grid);
+  EXPECT_EQ(result.bad_before, 1);
+  EXPECT_EQ(result.bad_after, 0);
+  EXPECT_EQ(audit_map_direction(grid, result.image, grid).flipped, 0);
+  EXPECT_LE(result.max_shift, ImageUntangleOptions().max_shift);
+}
+
+TEST(ImageUntangle, MovesNothingWithoutRoomOrFolds) {
+  const int n = 6;
+  const TriMesh grid = flat_grid(n);
+  // No fold: the input is returned.
+  const ImageUntangleResult clean = untangle_image(grid, grid.V, grid);
+  EXPECT_EQ(clean.bad_before, 0);
+  EXPECT_EQ(clean.moved, 0);
+  EXPECT_EQ(clean.image, grid.V);
+  // A fold but no room to move: left as it is, and counted.
+  Eigen::MatrixX3d image = grid.V;
+  image.row(vertex(n, 3, 3)) << 4.3, 3.2, 0;
+  ImageUntangleOptions options;
+  options.max_shift = 0;
+  const ImageUntangleResult stuck = untangle_image(grid, image, grid, options);
+  EXPECT_GT(stuck.bad_before, 0);
+  EXPECT_EQ(stuck.bad_after, stuck.bad_before);
+  EXPECT_EQ(stuck.moved, 0);
+}
+
+TEST(ImageUntangle, RejectsBadArguments) {
+  const TriMesh grid = flat_grid(3);
+  EXPECT_THROW(untangle_image(grid, Eigen::MatrixX3d::Zero(3, 3), grid), std::invalid_argument);
+  Eigen::MatrixX3d image = grid.V;
+  image(0, 0) = std::nan("");
+  EXPECT_THROW(untangle_image(grid, image, grid), std::invalid_argument);
+  ImageUntangleOptions options;
+  options.max_shift = -1;
+  EXPECT_THROW(untangle_image(grid, grid.V, grid, options), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace polycube
