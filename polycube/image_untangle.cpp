@@ -86,6 +86,10 @@ class Untangler {
     double shift;
   };
 
+  struct Frame {
+    Eigen::Vector3d normal, u, w;
+  };
+
   Eigen::Vector3d point(int v) const { return image_.row(v).transpose(); }
 
   // The vertices within kOptimiseRings edges of a bad triangle, in index order.
@@ -124,8 +128,8 @@ class Untangler {
   // The point p = old + x u + y w, |x|, |y| <= radius, where the smallest fan area is largest:
   // each fan area is linear in (x, y), so the optimum of their minimum over the square is a
   // corner, a point of a side where two areas are equal, or a point where three are.
-  Eigen::Vector2d widest_fan_point(int v, const Eigen::Vector3d& old, const Eigen::Vector3d& normal, const Eigen::Vector3d& u,
-                                   const Eigen::Vector3d& w, double radius) const {
+  Eigen::Vector2d widest_fan_point(int v, const Eigen::Vector3d& old, const Frame& frame, double radius) const {
+    const Eigen::Vector3d &normal = frame.normal, &u = frame.u, &w = frame.w;
     std::vector<Eigen::Vector3d> lines;  // area = l.x x + l.y y + l.z
     for (int f : star_[v]) {
       const int k = source_.F(f, 0) == v ? 0 : (source_.F(f, 1) == v ? 1 : 2);
@@ -169,21 +173,11 @@ class Untangler {
   // the widest-fan point within its shortest image edge, the whole, half or a quarter of the way.
   std::optional<Move> fan_move(int v, const Eigen::MatrixX3d& input, double max_shift) {
     const std::vector<int>& star = star_[v];
-    double shortest = kInfinity;
-    for (int f : star)
-      for (int c = 0; c < 3; ++c)
-        if (const int w = source_.F(f, c); w != v) {
-          const double length = (point(w) - point(v)).norm();
-          if (length > 0) shortest = std::min(shortest, length);
-        }
+    const double shortest = shortest_edge(v);
     if (!std::isfinite(shortest)) return std::nullopt;
-    const Eigen::Vector3d normal = surface_.area_vectors()[face_[v]].normalized();
-    Eigen::Vector3d u = normal.cross(Eigen::Vector3d::UnitX());
-    if (u.norm() < 0.5) u = normal.cross(Eigen::Vector3d::UnitY());
-    u.normalize();
-    const Eigen::Vector3d w = normal.cross(u);
+    const Frame frame = tangent_frame(v);
     const Eigen::Vector3d old = point(v), origin = input.row(v).transpose();
-    const double now = smallest_fan_area(v, old, normal);
+    const double now = smallest_fan_area(v, old, frame.normal);
     // Only squeezed fans move: a fan whose smallest area is a fair share of the mean is left.
     double mean = 0;
     for (int f : star) {
@@ -191,35 +185,73 @@ class Untangler {
       mean += 0.5 * (point(source_.F(f, 1)) - a).cross(point(source_.F(f, 2)) - a).norm() / star.size();
     }
     if (now > kSqueezedFan * mean) return std::nullopt;
-    const Eigen::Vector2d x = widest_fan_point(v, old, normal, u, w, shortest);
-    std::vector<bool> before(star.size());
-    int bad_before = 0;
-    for (size_t k = 0; k < star.size(); ++k) bad_before += before[k] = bad_[star[k]];
-    const int old_face = face_[v];
-    std::optional<Move> found;
+    const Eigen::Vector2d x = widest_fan_point(v, old, frame, shortest);
+    std::vector<bool> before;
+    const int bad_before = star_bad(v, before);
     for (double fraction : {1.0, 0.5, 0.25}) {
-      const Eigen::Vector3d q = surface_.project(old + fraction * (x.x() * u + x.y() * w)).first;
+      const Eigen::Vector3d q = surface_.project(old + fraction * (x.x() * frame.u + x.y() * frame.w)).first;
       if ((q - origin).norm() > max_shift || q == old) continue;
       // The gain must be real: a relative margin keeps the sweeps from creeping.
-      if (!(smallest_fan_area(v, q, normal) > now + 1e-9 * shortest * shortest)) continue;
+      if (!(smallest_fan_area(v, q, frame.normal) > now + 1e-9 * shortest * shortest)) continue;
       const int face = surface_.closest(q).first;
-      image_.row(v) = q.transpose();
-      face_[v] = face;
-      int bad_after = 0;
-      bool spoils = false;
-      for (size_t k = 0; k < star.size() && !spoils; ++k) {
-        const bool bad = judge(star[k]);
-        bad_after += bad;
-        spoils = bad && !before[k];
-      }
-      image_.row(v) = old.transpose();
-      face_[v] = old_face;
-      if (!spoils && bad_after <= bad_before) {
-        found = Move{v, q, face, (q - old).norm()};
+      if (const std::optional<int> bad_after = trial(v, q, face, before); bad_after && *bad_after <= bad_before)
+        return Move{v, q, face, (q - old).norm()};
+    }
+    return std::nullopt;
+  }
+
+  // v's shortest non-zero image edge (+infinity if none).
+  double shortest_edge(int v) const {
+    double shortest = kInfinity;
+    for (int f : star_[v])
+      for (int c = 0; c < 3; ++c)
+        if (const int w = source_.F(f, c); w != v) {
+          const double length = (point(w) - point(v)).norm();
+          if (length > 0) shortest = std::min(shortest, length);
+        }
+    return shortest;
+  }
+
+  // The unit normal of v's closest target face and two unit vectors spanning its plane.
+  Frame tangent_frame(int v) const {
+    Frame frame;
+    frame.normal = surface_.area_vectors()[face_[v]].normalized();
+    frame.u = frame.normal.cross(Eigen::Vector3d::UnitX());
+    if (frame.u.norm() < 0.5) frame.u = frame.normal.cross(Eigen::Vector3d::UnitY());
+    frame.u.normalize();
+    frame.w = frame.normal.cross(frame.u);
+    return frame;
+  }
+
+  // The bad flags of v's fan (in star order) and their number.
+  int star_bad(int v, std::vector<bool>& bad) const {
+    const std::vector<int>& star = star_[v];
+    bad.assign(star.size(), false);
+    int count = 0;
+    for (size_t k = 0; k < star.size(); ++k) count += bad[k] = bad_[star[k]];
+    return count;
+  }
+
+  // The bad triangles of v's fan with v's image at q (closest face `face`), or nothing if a
+  // triangle good `before` turns bad; v's image is left where it was.
+  std::optional<int> trial(int v, const Eigen::Vector3d& q, int face, const std::vector<bool>& before) {
+    const Eigen::Vector3d old = point(v);
+    const int old_face = face_[v];
+    image_.row(v) = q.transpose();
+    face_[v] = face;
+    const std::vector<int>& star = star_[v];
+    std::optional<int> bad_after = 0;
+    for (size_t k = 0; k < star.size(); ++k) {
+      const bool bad = judge(star[k]);
+      if (bad && !before[k]) {
+        bad_after.reset();
         break;
       }
+      *bad_after += bad;
     }
-    return found;
+    image_.row(v) = old.transpose();
+    face_[v] = old_face;
+    return bad_after;
   }
 
   bool judge(int f) const {
@@ -238,52 +270,28 @@ class Untangler {
 
   // The acceptable point round v's image closest to it (not farther than `bound`), if any.
   std::optional<Move> best_move(int v, const Eigen::MatrixX3d& input, double max_shift, double bound) {
-    const std::vector<int>& star = star_[v];
-    std::vector<bool> before(star.size());
-    int bad_before = 0;
-    for (size_t k = 0; k < star.size(); ++k) bad_before += before[k] = bad_[star[k]];
+    std::vector<bool> before;
+    const int bad_before = star_bad(v, before);
     if (bad_before == 0) return std::nullopt;
-    double shortest = kInfinity;
-    for (int f : star)
-      for (int c = 0; c < 3; ++c)
-        if (const int w = source_.F(f, c); w != v) {
-          const double length = (point(w) - point(v)).norm();
-          if (length > 0) shortest = std::min(shortest, length);
-        }
+    const double shortest = shortest_edge(v);
     if (!std::isfinite(shortest)) return std::nullopt;
-    const Eigen::Vector3d normal = surface_.area_vectors()[face_[v]].normalized();
-    Eigen::Vector3d u = normal.cross(Eigen::Vector3d::UnitX());
-    if (u.norm() < 0.5) u = normal.cross(Eigen::Vector3d::UnitY());
-    u.normalize();
-    const Eigen::Vector3d w = normal.cross(u);
-
+    const Frame frame = tangent_frame(v);
     const Eigen::Vector3d old = point(v), origin = input.row(v).transpose();
-    const int old_face = face_[v];
     std::optional<Move> best;
     for (double ring : kRings) {
       const double radius = ring * shortest;
       if (radius > kRingSlack * std::min(bound, best ? best->shift : kInfinity)) break;
       for (int d = 0; d < kDirections; ++d) {
         const double angle = 2 * M_PI * d / kDirections;
-        const Eigen::Vector3d q = surface_.project(old + radius * (std::cos(angle) * u + std::sin(angle) * w)).first;
+        const Eigen::Vector3d q = surface_.project(old + radius * (std::cos(angle) * frame.u + std::sin(angle) * frame.w)).first;
         const double shift = (q - old).norm();
         if ((q - origin).norm() > max_shift || shift == 0 || (best && shift >= best->shift) || shift >= bound) continue;
         // The face the audit finds for q (on an edge, the projection's face may be the other one).
         const int face = surface_.closest(q).first;
-        image_.row(v) = q.transpose();
-        face_[v] = face;
-        int bad_after = 0;
-        bool spoils = false;
-        for (size_t k = 0; k < star.size() && !spoils; ++k) {
-          const bool bad = judge(star[k]);
-          bad_after += bad;
-          spoils = bad && !before[k];
-        }
-        if (!spoils && bad_after < bad_before) best = Move{v, q, face, shift};
+        if (const std::optional<int> bad_after = trial(v, q, face, before); bad_after && *bad_after < bad_before)
+          best = Move{v, q, face, shift};
       }
     }
-    image_.row(v) = old.transpose();
-    face_[v] = old_face;
     return best;
   }
 
