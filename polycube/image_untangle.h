@@ -14,14 +14,23 @@
 // diagonal from where the map put it (reported), so the two files remain inverse to each other
 // to within that distance.
 //
-// Method. While bad triangles (flipped, as audit_map judges them with the same closest faces, or
-// degenerate) remain, for each bad triangle, each of its corners tries points round its image in
-// the tangent plane of its closest target face — on rings of radius 5 %, 10 %, 20 %, 35 %, 50 %,
-// 75 % of its shortest image edge, 16 directions each — projected onto the target (closest
-// point). A point is acceptable if it leaves fewer bad triangles round the vertex and turns none
-// of them from good to bad; of all acceptable points of the three corners the closest to the
-// current image is taken. Every move lowers the number of bad triangles, so the step ends, and
-// it never adds a bad triangle.
+// Method. Sweeps, while bad triangles (flipped, as audit_map judges them with the same closest
+// faces, or degenerate) remain:
+//   1. for each bad triangle, each of its corners tries points round its image in the tangent
+//      plane of its closest target face — on rings of radius 5 % to 200 % of its shortest image
+//      edge, 16 directions each — projected onto the target (closest point). A point is
+//      acceptable if it leaves fewer bad triangles round the vertex and turns none of them from
+//      good to bad; of all acceptable points of the three corners the closest to the current
+//      image is taken;
+//   2. a sweep of 1 that moves nothing is followed by one over the vertices within two edges of a
+//      bad triangle whose fans are squeezed (smallest signed area in the tangent plane below a
+//      quarter of the fan's mean): each moves towards the point of a square round it (half-width:
+//      its shortest image edge) where that smallest area is largest — the areas are linear in the
+//      position, so the optimum is a corner, a side point where two are equal or a point where
+//      three are — the whole, half or a quarter of the way, if that raises the smallest area,
+//      leaves no more bad triangles round it and turns none bad. This makes room where a fold
+//      spans several vertices and no single move of step 1 unfolds it.
+// Neither kind of move adds a bad triangle, so their number never grows; step 1 lowers it.
 #pragma once
 
 #include "polycube/mesh.h"
