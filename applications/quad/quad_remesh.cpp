@@ -287,21 +287,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       QuadRemeshResult pass;
       QuadMiss next;
       std::pair<int, int> pass_bad;
-      // When the warm pass (started from the quads it refines) flipped a quad: the round's grid
-      // again as the first pass ran, carried by the map and relaxed with all the sweeps.
-      const auto cold_again = [&]() {
-        if (pass_bad.first <= best_bad.first || options.refine.warm_sweeps <= 0) return;
-        report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
-                             " flipped or degenerate quads from the quads it refines; again through the map");
-        QuadRemeshResult cold;
-        cold.grid = std::move(pass.grid);
-        run_pass(cold, true, nullptr);
-        pass = std::move(cold);
-        next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
-        pass_bad = bad(pass);
-      };
-      // cold_fallback: off for the first try of a round, whose bad quads are blamed first (below).
-      const auto attempt = [&](bool cold_fallback) {
+      const auto attempt = [&]() {
         PolycubeGrid grid = build_polycube_grid(polycube, grid_options, size_map);
         if (grid.refined_parts == current.grid.refined_parts) return false;
         pass = QuadRemeshResult{};
@@ -309,10 +295,21 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         run_pass(pass, true, &current);
         next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
         pass_bad = bad(pass);
-        if (cold_fallback) cold_again();
+        if (pass_bad.first > best_bad.first && options.refine.warm_sweeps > 0) {
+          // Started from the quads it refines, the round flipped a quad: the round's grid again as
+          // the first pass ran, carried by the map and relaxed with all the sweeps.
+          report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
+                               " flipped or degenerate quads from the quads it refines; again through the map");
+          QuadRemeshResult cold;
+          cold.grid = std::move(pass.grid);
+          run_pass(cold, true, nullptr);
+          pass = std::move(cold);
+          next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
+          pass_bad = bad(pass);
+        }
         return true;
       };
-      bool refined = attempt(false);
+      bool refined = attempt();
       int blamed = -1;  // places blamed for this pass's bad quads (-1: not yet)
       if (refined && pass_bad.first > best_bad.first) {
         // The map folds where the round's lines went: once more without the places near the bad
@@ -325,14 +322,11 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         report("refine", "round " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
                              " flipped or degenerate quads; again without the " + std::to_string(before - places.size()) +
                              " of its " + std::to_string(before) + " places whose lines run by them");
-        // Else, or when that gains no part, the round's own grid through the map (cold), with
-        // the places it was made from.
-        if (before == places.size() || places.empty() || !attempt(true)) {
-          places = kept_places;  // pass is still the round's first
-          cold_again();
-        } else {
+        // Else, or when that gains no part, the bad pass stays (with the places it was made from).
+        if (before == places.size() || places.empty() || !attempt())
+          places = kept_places;
+        else
           blamed = -1;  // a new pass
-        }
       }
       if (!refined) {  // the budget is spent
         grid_options.refine_rounds.pop_back();
