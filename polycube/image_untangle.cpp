@@ -31,14 +31,20 @@ constexpr double kSqueezedFan = 0.25;
 
 class Untangler {
  public:
-  Untangler(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target)
-      : source_(source), surface_(target, "untangle_image"), image_(image), face_(source.num_vertices()),
-        star_(source.num_vertices()), bad_(source.num_faces()) {
+  Untangler(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target, const ImageUntangleOptions& options)
+      : source_(source), surface_(target, "untangle_image"), input_(image), image_(image), face_(source.num_vertices()),
+        star_(source.num_vertices()), bad_(source.num_faces()), room_(source.num_vertices()) {
     degenerate_area_ = kAuditDegenerateArea * surface_area(target);
     for (int v = 0; v < source.num_vertices(); ++v) face_[v] = surface_.closest(point(v)).first;
     for (int f = 0; f < source.num_faces(); ++f) {
       for (int c = 0; c < 3; ++c) star_[source.F(f, c)].push_back(f);
       bad_[f] = judge(f);
+    }
+    // Each image's room: the larger of the diagonal's share and the share of its shortest edge.
+    const double diagonal_room = options.max_shift * bounding_box(target.V).diagonal();
+    for (int v = 0; v < source.num_vertices(); ++v) {
+      const double shortest = shortest_edge(v);
+      room_[v] = std::max(diagonal_room, std::isfinite(shortest) ? options.max_edge_share * shortest : 0.0);
     }
   }
 
@@ -48,10 +54,10 @@ class Untangler {
   // One sweep of the second kind (see the header): every vertex within kOptimiseRings of a bad
   // triangle moves towards the point of its tangent plane where the smallest signed area of its
   // fan is largest; returns whether any vertex moved.
-  bool optimise(const Eigen::MatrixX3d& input, double max_shift) {
+  bool optimise() {
     bool moved = false;
     for (int v : near_bad()) {
-      const std::optional<Move> move = fan_move(v, input, max_shift);
+      const std::optional<Move> move = fan_move(v);
       if (!move) continue;
       place(move->vertex, move->point, move->face);
       moved = true;
@@ -60,13 +66,13 @@ class Untangler {
   }
 
   // One sweep over the triangles still bad; returns whether any vertex moved.
-  bool sweep(const Eigen::MatrixX3d& input, double max_shift) {
+  bool sweep() {
     bool moved = false;
     for (int f = 0; f < source_.num_faces(); ++f) {
       if (!bad_[f]) continue;
       std::optional<Move> best;
       for (int c = 0; c < 3; ++c) {
-        const std::optional<Move> move = best_move(source_.F(f, c), input, max_shift, best ? best->shift : kInfinity);
+        const std::optional<Move> move = best_move(source_.F(f, c), best ? best->shift : kInfinity);
         if (move && (!best || move->shift < best->shift)) best = move;
       }
       if (!best) continue;
@@ -171,12 +177,12 @@ class Untangler {
   // A move of v that raises the smallest signed area of its fan (in the tangent plane of its
   // closest face) without raising the bad triangles round it or turning a good one bad: towards
   // the widest-fan point within its shortest image edge, the whole, half or a quarter of the way.
-  std::optional<Move> fan_move(int v, const Eigen::MatrixX3d& input, double max_shift) {
+  std::optional<Move> fan_move(int v) {
     const std::vector<int>& star = star_[v];
     const double shortest = shortest_edge(v);
     if (!std::isfinite(shortest)) return std::nullopt;
     const Frame frame = tangent_frame(v);
-    const Eigen::Vector3d old = point(v), origin = input.row(v).transpose();
+    const Eigen::Vector3d old = point(v), origin = input_.row(v).transpose();
     const double now = smallest_fan_area(v, old, frame.normal);
     // Only squeezed fans move: a fan whose smallest area is a fair share of the mean is left.
     double mean = 0;
@@ -190,7 +196,7 @@ class Untangler {
     const int bad_before = star_bad(v, before);
     for (double fraction : {1.0, 0.5, 0.25}) {
       const Eigen::Vector3d q = surface_.project(old + fraction * (x.x() * frame.u + x.y() * frame.w)).first;
-      if ((q - origin).norm() > max_shift || q == old) continue;
+      if ((q - origin).norm() > room_[v] || q == old) continue;
       // The gain must be real: a relative margin keeps the sweeps from creeping.
       if (!(smallest_fan_area(v, q, frame.normal) > now + 1e-9 * shortest * shortest)) continue;
       const int face = surface_.closest(q).first;
@@ -269,14 +275,14 @@ class Untangler {
   }
 
   // The acceptable point round v's image closest to it (not farther than `bound`), if any.
-  std::optional<Move> best_move(int v, const Eigen::MatrixX3d& input, double max_shift, double bound) {
+  std::optional<Move> best_move(int v, double bound) {
     std::vector<bool> before;
     const int bad_before = star_bad(v, before);
     if (bad_before == 0) return std::nullopt;
     const double shortest = shortest_edge(v);
     if (!std::isfinite(shortest)) return std::nullopt;
     const Frame frame = tangent_frame(v);
-    const Eigen::Vector3d old = point(v), origin = input.row(v).transpose();
+    const Eigen::Vector3d old = point(v), origin = input_.row(v).transpose();
     std::optional<Move> best;
     for (double ring : kRings) {
       const double radius = ring * shortest;
@@ -285,7 +291,7 @@ class Untangler {
         const double angle = 2 * M_PI * d / kDirections;
         const Eigen::Vector3d q = surface_.project(old + radius * (std::cos(angle) * frame.u + std::sin(angle) * frame.w)).first;
         const double shift = (q - old).norm();
-        if ((q - origin).norm() > max_shift || shift == 0 || (best && shift >= best->shift) || shift >= bound) continue;
+        if ((q - origin).norm() > room_[v] || shift == 0 || (best && shift >= best->shift) || shift >= bound) continue;
         // The face the audit finds for q (on an edge, the projection's face may be the other one).
         const int face = surface_.closest(q).first;
         if (const std::optional<int> bad_after = trial(v, q, face, before); bad_after && *bad_after < bad_before)
@@ -297,10 +303,12 @@ class Untangler {
 
   const TriMesh& source_;
   TargetSurface surface_;
+  const Eigen::MatrixX3d& input_;      // the images as the map gave them
   Eigen::MatrixX3d image_;
   std::vector<int> face_;               // closest target face of each image vertex
   std::vector<std::vector<int>> star_;  // source faces round each vertex
   std::vector<bool> bad_;               // per source face: flipped or degenerate image
+  std::vector<double> room_;            // per image: how far it may move from input_
   double degenerate_area_ = 0;
 };
 
@@ -311,15 +319,14 @@ ImageUntangleResult untangle_image(const TriMesh& source, const Eigen::MatrixX3d
   if (image.rows() != source.num_vertices() || !image.allFinite())
     throw std::invalid_argument("untangle_image: image needs one finite row per source vertex (" +
                                 std::to_string(source.num_vertices()) + "), got " + std::to_string(image.rows()) + " rows");
-  if (options.sweeps < 0 || !(options.max_shift >= 0))
-    throw std::invalid_argument("untangle_image: sweeps and max_shift must be >= 0");
-  Untangler untangler(source, image, target);
+  if (options.sweeps < 0 || !(options.max_shift >= 0) || !(options.max_edge_share >= 0))
+    throw std::invalid_argument("untangle_image: sweeps, max_shift and max_edge_share must be >= 0");
+  Untangler untangler(source, image, target, options);
   ImageUntangleResult result;
   result.bad_before = untangler.bad_count();
   const double diagonal = bounding_box(target.V).diagonal();
-  const double max_shift = options.max_shift * diagonal;
   for (int s = 0; s < options.sweeps && untangler.bad_count() > 0; ++s)
-    if (!untangler.sweep(image, max_shift) && !untangler.optimise(image, max_shift)) break;
+    if (!untangler.sweep() && !untangler.optimise()) break;
   result.image = untangler.image();
   result.bad_after = untangler.bad_count();
   for (int v = 0; v < source.num_vertices(); ++v) {

@@ -11,8 +11,8 @@
 // image relocates the P vertices round it), and there a move that unfolds one direction is
 // refused when it folds the other. Here each direction's file is corrected on its own: the
 // images stay points of the target surface, each moved at most `max_shift` of the target's
-// diagonal from where the map put it (reported), so the two files remain inverse to each other
-// to within that distance.
+// diagonal, or a quarter of its shortest edge if that is more, from where the map put it
+// (reported), so the two files remain inverse to each other to within that distance.
 //
 // Method. Sweeps, while bad triangles (flipped, as audit_map judges them with the same closest
 // faces, or degenerate) remain:
@@ -42,9 +42,12 @@ namespace polycube {
 struct ImageUntangleOptions {
   // Sweeps over the bad triangles (each sweep tries every one still bad).
   int sweeps = 20;
-  // Largest distance of a moved image from its input position, × the target's bounding-box
-  // diagonal.
+  // How far an image may move from its input position: the larger of max_shift × the target's
+  // bounding-box diagonal and max_edge_share × the image's shortest edge in the input (the
+  // sampled map is off the exact one by about its edges anyway: on a coarse model whose triangles
+  // span much of P, a move of a few per cent of the diagonal is small against them).
   double max_shift = 0.01;
+  double max_edge_share = 0.25;
 };
 
 // The corrected images and what it took.

@@ -41,6 +41,7 @@ TEST(ImageUntangle, UnfoldsAVertexDraggedAcrossItsNeighbours) {
 
   ImageUntangleOptions options;
   options.max_shift = 0.2;  // the drag was 1.3 / 14.1 of the diagonal
+  options.max_edge_share = 0;
   const ImageUntangleResult result = untangle_image(grid, image, grid, options);
   EXPECT_EQ(result.bad_before, folded.flipped + folded.degenerate);
   EXPECT_EQ(result.bad_after, 0);
@@ -89,6 +90,7 @@ TEST(ImageUntangle, MovesNothingWithoutRoomOrFolds) {
   image.row(vertex(n, 3, 3)) << 4.3, 3.2, 0;
   ImageUntangleOptions options;
   options.max_shift = 0;
+  options.max_edge_share = 0;
   const ImageUntangleResult stuck = untangle_image(grid, image, grid, options);
   EXPECT_GT(stuck.bad_before, 0);
   EXPECT_EQ(stuck.bad_after, stuck.bad_before);
@@ -103,6 +105,9 @@ TEST(ImageUntangle, RejectsBadArguments) {
   EXPECT_THROW(untangle_image(grid, image, grid), std::invalid_argument);
   ImageUntangleOptions options;
   options.max_shift = -1;
+  EXPECT_THROW(untangle_image(grid, grid.V, grid, options), std::invalid_argument);
+  options.max_shift = 0.01;
+  options.max_edge_share = -1;
   EXPECT_THROW(untangle_image(grid, grid.V, grid, options), std::invalid_argument);
 }
 
