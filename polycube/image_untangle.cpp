@@ -1,6 +1,7 @@
 #include "polycube/image_untangle.h"
 
 #include "polycube/image_orientation.h"
+#include "polycube/max_min_affine.h"
 #include "polycube/map_audit.h"
 #include "polycube/target_surface.h"
 
@@ -131,47 +132,19 @@ class Untangler {
     return smallest;
   }
 
-  // The point p = old + x u + y w, |x|, |y| <= radius, where the smallest fan area is largest:
-  // each fan area is linear in (x, y), so the optimum of their minimum over the square is a
-  // corner, a point of a side where two areas are equal, or a point where three are.
+  // The point p = old + x u + y w, |x|, |y| <= radius, where the smallest fan area is largest
+  // (each fan area is affine in (x, y): max_min_affine.h).
   Eigen::Vector2d widest_fan_point(int v, const Eigen::Vector3d& old, const Frame& frame, double radius) const {
-    const Eigen::Vector3d &normal = frame.normal, &u = frame.u, &w = frame.w;
-    std::vector<Eigen::Vector3d> lines;  // area = l.x x + l.y y + l.z
+    std::vector<double> a;
+    std::vector<Eigen::Vector2d> g;
     for (int f : star_[v]) {
       const int k = source_.F(f, 0) == v ? 0 : (source_.F(f, 1) == v ? 1 : 2);
       const Eigen::Vector3d q = point(source_.F(f, (k + 1) % 3)), r = point(source_.F(f, (k + 2) % 3));
-      auto area = [&](const Eigen::Vector3d& p) { return 0.5 * normal.dot((q - p).cross(r - p)); };
-      const double at = area(old);
-      lines.emplace_back(area(old + u) - at, area(old + w) - at, at);
+      auto area = [&](const Eigen::Vector3d& p) { return 0.5 * frame.normal.dot((q - p).cross(r - p)); };
+      a.push_back(area(old));
+      g.emplace_back(area(old + frame.u) - a.back(), area(old + frame.w) - a.back());
     }
-    auto smallest = [&](const Eigen::Vector2d& x) {
-      double m = kInfinity;
-      for (const Eigen::Vector3d& l : lines) m = std::min(m, l.x() * x.x() + l.y() * x.y() + l.z());
-      return m;
-    };
-    Eigen::Vector2d best(0, 0);
-    double best_value = smallest(best);
-    auto consider = [&](const Eigen::Vector2d& x) {
-      if (!x.allFinite() || std::abs(x.x()) > radius * (1 + 1e-12) || std::abs(x.y()) > radius * (1 + 1e-12)) return;
-      if (const double value = smallest(x); value > best_value) best = x, best_value = value;
-    };
-    for (int sx : {-1, 1})
-      for (int sy : {-1, 1}) consider(Eigen::Vector2d(sx * radius, sy * radius));
-    const int n = static_cast<int>(lines.size());
-    for (int i = 0; i < n; ++i)
-      for (int j = i + 1; j < n; ++j) {
-        const Eigen::Vector3d d = lines[i] - lines[j];  // d.x x + d.y y + d.z = 0 on the tie
-        for (int side : {-1, 1}) {
-          if (d.y() != 0) consider(Eigen::Vector2d(side * radius, -(d.z() + d.x() * side * radius) / d.y()));
-          if (d.x() != 0) consider(Eigen::Vector2d(-(d.z() + d.y() * side * radius) / d.x(), side * radius));
-        }
-        for (int k = j + 1; k < n; ++k) {
-          const Eigen::Vector3d e = lines[i] - lines[k];
-          const double det = d.x() * e.y() - d.y() * e.x();
-          if (det != 0) consider(Eigen::Vector2d((-d.z() * e.y() + d.y() * e.z()) / det, (-d.x() * e.z() + d.z() * e.x()) / det));
-        }
-      }
-    return best;
+    return max_min_affine(a, g, radius).q;
   }
 
   // A move of v that raises the smallest signed area of its fan (in the tangent plane of its

@@ -2,6 +2,7 @@
 
 #include "polycube/closest_point.h"
 #include "polycube/image_orientation.h"
+#include "polycube/max_min_affine.h"
 
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
@@ -621,32 +622,9 @@ class ForwardMap {
       a[k] = cross2(u, w);
       g[k] = Vec2(u.y() - w.y(), w.x() - u.x());
     }
-    auto smallest = [&](const Vec2& q) {
-      double m = INFINITY;
-      for (size_t k = 0; k < n; ++k) m = std::min(m, a[k] + g[k].dot(q));
-      return m;
-    };
-    Vec2 best_q = Vec2::Zero();
-    double best = smallest(best_q);
-    for (size_t i = 0; i < n; ++i)
-      for (size_t j = i + 1; j < n; ++j)
-        for (size_t k = j + 1; k < n; ++k) {
-          // a_i + g_i q = a_j + g_j q = a_k + g_k q
-          Eigen::Matrix2d A;
-          A.row(0) = (g[i] - g[j]).transpose();
-          A.row(1) = (g[i] - g[k]).transpose();
-          const double det = A.determinant();
-          if (!(std::abs(det) > 1e-300)) continue;
-          const Vec2 q = A.inverse() * Vec2(a[j] - a[i], a[k] - a[i]);
-          if (!q.allFinite()) continue;
-          const double m = smallest(q);
-          if (m > best) {
-            best = m;
-            best_q = q;
-          }
-        }
-    if (!(best > 0)) return false;
-    target = c + best_q.x() * e1 + best_q.y() * e2;
+    const MaxMinPoint best = max_min_affine(a, g);
+    if (!(best.value > 0)) return false;
+    target = c + best.q.x() * e1 + best.q.y() * e2;
     return true;
   }
 
