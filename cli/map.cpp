@@ -209,7 +209,7 @@ std::string refinement_line(const MapRefinementResult& r) {
 
 // The last correction of the files (image_untangle.h): where an image triangle of either
 // direction is still flipped or degenerate, single vertex images move on the target surface until
-// the audit passes there; then the audit again.
+// the audit passes there; then that direction's audit again.
 void untangle_images(const TriMesh& model, Finished& out, double max_shift, const Progress& progress) {
   if ((out.bad_p() == 0 && out.bad_m() == 0) || max_shift <= 0) return;
   const double start = progress.elapsed_seconds();
@@ -225,9 +225,18 @@ void untangle_images(const TriMesh& model, Finished& out, double max_shift, cons
                           {"moved", result.moved}, {"max_shift", result.max_shift}};
   };
   out.untangling = nlohmann::json::object();
-  if (out.bad_p() > 0) out.untangling["polycube_to_model"] = run(P, out.on_model_xyz, model);
-  if (out.bad_m() > 0) out.untangling["model_to_polycube"] = run(model, out.on_polycube_xyz, P);
-  out.audit = audit_map(model, P, out.on_model_xyz, out.on_polycube_xyz);
+  // Only the direction moved is audited again (and the distortion, which P → M defines).
+  MapAudit& audit = out.audit;
+  if (out.bad_p() > 0) {
+    out.untangling["polycube_to_model"] = run(P, out.on_model_xyz, model);
+    audit.polycube_to_model = audit_map_direction(P, out.on_model_xyz, model);
+    audit.distortion = map_distortion(P, out.on_model_xyz);
+  }
+  if (out.bad_m() > 0) {
+    out.untangling["model_to_polycube"] = run(model, out.on_polycube_xyz, P);
+    audit.model_to_polycube = audit_map_direction(model, out.on_polycube_xyz, P);
+  }
+  audit.ok = audit.polycube_to_model.ok && audit.model_to_polycube.ok;
   out.untangle_seconds = progress.elapsed_seconds() - start;
   out.untangling["seconds"] = out.untangle_seconds;
   progress.stage("untangle", std::to_string(out.bad_p()) + " / " + std::to_string(out.bad_m()) + " left");

@@ -1,8 +1,6 @@
 #include "polycube/image_untangle.h"
 
-#include "polycube/image_orientation.h"
 #include "polycube/max_min_affine.h"
-#include "polycube/map_audit.h"
 #include "polycube/target_surface.h"
 
 #include <Eigen/Geometry>
@@ -35,14 +33,13 @@ class Untangler {
   Untangler(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target, const ImageUntangleOptions& options)
       : source_(source), surface_(target, "untangle_image"), input_(image), image_(image), face_(source.num_vertices()),
         star_(source.num_vertices()), bad_(source.num_faces()), room_(source.num_vertices()) {
-    degenerate_area_ = kAuditDegenerateArea * surface_area(target);
     for (int v = 0; v < source.num_vertices(); ++v) face_[v] = surface_.closest(point(v)).first;
     for (int f = 0; f < source.num_faces(); ++f) {
       for (int c = 0; c < 3; ++c) star_[source.F(f, c)].push_back(f);
       bad_[f] = judge(f);
     }
     // Each image's room: the larger of the diagonal's share and the share of its shortest edge.
-    const double diagonal_room = options.max_shift * bounding_box(target.V).diagonal();
+    const double diagonal_room = options.max_shift * surface_.diagonal();
     for (int v = 0; v < source.num_vertices(); ++v) {
       const double shortest = shortest_edge(v);
       room_[v] = std::max(diagonal_room, std::isfinite(shortest) ? options.max_edge_share * shortest : 0.0);
@@ -235,10 +232,7 @@ class Untangler {
 
   bool judge(int f) const {
     const int a = source_.F(f, 0), b = source_.F(f, 1), c = source_.F(f, 2);
-    const Eigen::Vector3d pa = point(a), pb = point(b), pc = point(c);
-    if (0.5 * (pb - pa).cross(pc - pa).norm() <= degenerate_area_) return true;
-    const auto closest = [this](const Eigen::Vector3d& p, int) { return surface_.closest(p).first; };
-    return image_triangle_flipped(pa, pb, pc, face_[a], face_[b], face_[c], surface_.area_vectors(), closest);
+    return surface_.judge(point(a), point(b), point(c), face_[a], face_[b], face_[c]) != 0;
   }
 
   void place(int v, const Eigen::Vector3d& p, int face) {
@@ -282,7 +276,6 @@ class Untangler {
   std::vector<std::vector<int>> star_;  // source faces round each vertex
   std::vector<bool> bad_;               // per source face: flipped or degenerate image
   std::vector<double> room_;            // per image: how far it may move from input_
-  double degenerate_area_ = 0;
 };
 
 }  // namespace

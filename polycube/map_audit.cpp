@@ -1,7 +1,5 @@
 #include "polycube/map_audit.h"
 
-#include "polycube/image_orientation.h"
-
 #include "polycube/target_surface.h"
 
 #include <Eigen/Geometry>
@@ -44,8 +42,8 @@ MapDirectionAudit audit_map_direction(const TriMesh& source, const Eigen::Matrix
   if (!target.V.allFinite()) throw std::invalid_argument("audit_map: target has non-finite vertices");
 
   const TargetSurface surface(target, "audit_map");
-  const double target_area = surface_area(target);
-  const double diagonal = bounding_box(target.V).diagonal();
+  const double target_area = surface.area();
+  const double diagonal = surface.diagonal();
 
   // Closest target face of every image vertex (-1 when the vertex is not finite).
   MapDirectionAudit audit;
@@ -69,20 +67,14 @@ MapDirectionAudit audit_map_direction(const TriMesh& source, const Eigen::Matrix
       continue;
     }
     const Eigen::Vector3d a = row(image, corner[0]), b = row(image, corner[1]), c = row(image, corner[2]);
-    const Eigen::Vector3d normal = (b - a).cross(c - a);
-    const double area = 0.5 * normal.norm();
-    image_area += area;
-    if (area <= kAuditDegenerateArea * target_area) {
-      ++audit.degenerate;
-      continue;
-    }
+    image_area += 0.5 * (b - a).cross(c - a).norm();
     // The target's outward normal near the triangle: the distinct faces closest to its centroid
     // and to its corners, area-weighted. Across a polycube edge the corners find both faces, and
     // a correctly oriented chord has a positive dot product with each of them.
     // (image_orientation.h: the faces nearest the centroid and corners, then a finer look.)
-    const auto closest = [&surface](const Eigen::Vector3d& p, int) { return surface.closest(p).first; };
-    if (image_triangle_flipped(a, b, c, vertex_face[corner[0]], vertex_face[corner[1]], vertex_face[corner[2]], surface.area_vectors(), closest))
-      ++audit.flipped;
+    const int verdict = surface.judge(a, b, c, vertex_face[corner[0]], vertex_face[corner[1]], vertex_face[corner[2]]);
+    audit.degenerate += verdict == 2;
+    audit.flipped += verdict == 1;
   }
   audit.area_ratio = image_area / target_area;
   audit.ok = audit.flipped == 0 && audit.degenerate == 0 && audit.max_distance <= options.surface_tolerance &&

@@ -4,7 +4,7 @@
 #include "polycube/map_quality.h"
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
-#include "polycube/triangle_tree.h"
+#include "polycube/target_surface.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -28,7 +28,6 @@ namespace polycube {
 
 namespace {
 
-using namespace triangle_tree;
 using Vec3 = Eigen::Vector3d;
 using Clock = std::chrono::steady_clock;
 
@@ -36,61 +35,24 @@ using Clock = std::chrono::steady_clock;
 // (as a fraction of their length); otherwise at their midpoint.
 constexpr double kPlaneSplitMin = 0.1;
 
-// Image triangles at or below this fraction of the target area are degenerate (the audit's).
-constexpr double kDegenerateArea = 1e-14;
-
 // A split at the model's edges is undone when its triangles' angle distortion weighted by image
 // area (as in ε_angle) exceeds that of the triangles it split plus this times the area it adds.
 constexpr double kMaxSplitDistortion = 3;
 
 Vec3 row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpose(); }
 
-// The audit's judgement of image triangles on the model (map_audit.cpp, audit_map_direction):
-// closest faces from the same AABB tree over the same triangles (zero-area faces left out), so
-// every tie is broken the same way.
-class AuditTarget {
+// The audit's judgement of image triangles on the model (TargetSurface: the audit's closest
+// faces and verdict), and closest points as points of a target face.
+class AuditTarget : public TargetSurface {
  public:
-  explicit AuditTarget(const TriMesh& target) {
-    for (int f = 0; f < target.num_faces(); ++f) {
-      const Vec3 a = row(target.V, target.F(f, 0));
-      area_vectors_.push_back((row(target.V, target.F(f, 1)) - a).cross(row(target.V, target.F(f, 2)) - a));
-      area_ += 0.5 * area_vectors_.back().norm();
-      if (area_vectors_.back().squaredNorm() == 0) continue;
-      triangles_.emplace_back(point(target, target.F(f, 0)), point(target, target.F(f, 1)), point(target, target.F(f, 2)));
-      faces_.push_back(f);
-    }
-    if (triangles_.empty()) throw std::invalid_argument("refine_map_sampling: the model has zero area");
-    tree_.rebuild(triangles_.begin(), triangles_.end());
-    tree_.accelerate_distance_queries();
-    diagonal_ = bounding_box(target.V).diagonal();
-  }
-  AuditTarget(const AuditTarget&) = delete;
-  AuditTarget& operator=(const AuditTarget&) = delete;
-
-  // Closest target face to p and the distance to it.
-  std::pair<int, double> closest(const Vec3& p) const {
-    const Point q(p.x(), p.y(), p.z());
-    const auto [hit, id] = tree_.closest_point_and_primitive(q);
-    return {faces_[static_cast<size_t>(id - triangles_.begin())], std::sqrt(CGAL::squared_distance(q, hit))};
-  }
-
-  // 0: good, 1: flipped, 2: degenerate — the image triangle (a, b, c) whose corners' closest
-  // faces are fa, fb, fc.
-  int judge(const Vec3& a, const Vec3& b, const Vec3& c, int fa, int fb, int fc) const {
-    const Vec3 n = (b - a).cross(c - a);
-    if (0.5 * n.norm() <= kDegenerateArea * area_) return 2;
-    const auto nearest = [this](const Vec3& p, int) { return closest(p).first; };
-    return image_triangle_flipped(a, b, c, fa, fb, fc, area_vectors_, nearest) ? 1 : 0;
-  }
+  explicit AuditTarget(const TriMesh& target) : TargetSurface(target, "refine_map_sampling") {}
 
   // The closest point of the target to p, as a point of a target face.
   SurfacePoint closest_point(const TriMesh& target, const Vec3& p) const {
-    const Point q(p.x(), p.y(), p.z());
-    const auto [hit, id] = tree_.closest_point_and_primitive(q);
+    const auto [x, face] = project(p);
     SurfacePoint out;
-    out.face = faces_[static_cast<size_t>(id - triangles_.begin())];
-    const Vec3 a = row(target.V, target.F(out.face, 0)), b = row(target.V, target.F(out.face, 1)), c = row(target.V, target.F(out.face, 2));
-    const Vec3 x(hit.x(), hit.y(), hit.z());
+    out.face = face;
+    const Vec3 a = row(target.V, target.F(face, 0)), b = row(target.V, target.F(face, 1)), c = row(target.V, target.F(face, 2));
     const Vec3 n = (b - a).cross(c - a);
     const double nn = n.squaredNorm();
     out.bary = Vec3((c - b).cross(x - b).dot(n) / nn, (a - c).cross(x - c).dot(n) / nn, 0);
@@ -99,17 +61,6 @@ class AuditTarget {
     out.bary /= out.bary.sum();
     return out;
   }
-
-  double area() const { return area_; }
-  double diagonal() const { return diagonal_; }
-
- private:
-  std::vector<Vec3> area_vectors_;
-  std::vector<Triangle> triangles_;
-  std::vector<int> faces_;
-  double area_ = 0;
-  double diagonal_ = 0;
-  Tree tree_;
 };
 
 double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) { return 0.5 * (b - a).cross(c - a).norm(); }

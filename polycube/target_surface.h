@@ -1,7 +1,8 @@
 // Internal (CGAL; include only from engine .cpp files): closest points on the surface a map's
-// images should lie on, with the faces' area vectors the orientation test needs. Shared by the
-// audit (map_audit.cpp) and the final untangling of image triangles (image_untangle.cpp), which
-// must find the same closest faces.
+// images should lie on, with the faces' area vectors the orientation test needs, and the audit's
+// judgement of one image triangle. Shared by the audit (map_audit.cpp), the refinement of P's
+// sampling (map_refinement.cpp) and the last untangling (image_untangle.cpp), which must find the
+// same closest faces (the same tree over the same triangles breaks every tie the same way).
 #pragma once
 
 #include "polycube/mesh.h"
@@ -33,10 +34,20 @@ class TargetSurface {
   // Per target face: twice the area times the outward unit normal.
   const std::vector<Eigen::Vector3d>& area_vectors() const { return area_vectors_; }
 
+  // The target's area (Σ face areas) and bounding-box diagonal.
+  double area() const { return area_; }
+  double diagonal() const { return diagonal_; }
+
+  // The audit's verdict on the image triangle (a, b, c) whose corners' closest faces are fa, fb,
+  // fc: 0 good, 1 flipped (image_orientation.h), 2 degenerate (area <= kAuditDegenerateArea ×
+  // the target's).
+  int judge(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc) const;
+
  private:
   std::vector<Eigen::Vector3d> area_vectors_;
   std::vector<triangle_tree::Triangle> triangles_;
   std::vector<int> faces_;  // target face of each tree triangle
+  double area_ = 0, diagonal_ = 0;
   triangle_tree::Tree tree_;
 };
 
