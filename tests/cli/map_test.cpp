@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -147,11 +148,20 @@ TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
   EXPECT_LT(report.at("map").at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
 }
 
+// A finished map's rank as `map` ranks them: flipped and degenerate triangles both ways, whether
+// it meets the contract, how far P's image area is outside 2 %, ε_angle.
+std::tuple<int, int, double, double> finished_rank(const nlohmann::json& f) {
+  return std::make_tuple(f.at("polycube_to_model_flipped").get<int>() + f.at("model_to_polycube_flipped").get<int>(),
+                         f.at("meets_contract").get<bool>() ? 0 : 1, std::max(0.0, std::abs(f.at("area_ratio").get<double>() - 1) - 0.02),
+                         f.at("eps_angle").get<double>());
+}
+
 // When the winner's finished map (refined, smoothed) still has flips or P's image misses 2 % of the area,
 // the search's next candidates are finished too and the best finished map is written: helmet
 // (1000 triangles) ends its winner with 2 flipped P → M triangles when the last untangling of the
 // files is off (`--untangle-shift 0`; with it, the winner meets the contract). The kept one ranks first by flips, then
-// whether it meets that contract, then ε_angle; the files and the report are its, in its frame.
+// whether it meets that contract, then how far its image area is off, then ε_angle; the files and the report
+// are its, in its frame.
 TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   const std::string dir = test::temp_dir("map-retry");
   const CliRun run = polycube_cli("map --quiet --untangle-shift 0 " + quoted(test::data_path("helmet.off")) + " -o " + quoted(dir));
@@ -162,10 +172,7 @@ TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   ASSERT_GE(finished.size(), 2u);
   EXPECT_FALSE(finished.at(0).at("meets_contract").get<bool>());
   int kept = -1;
-  auto rank = [&](const nlohmann::json& f) {
-    return std::make_tuple(f.at("polycube_to_model_flipped").get<int>() + f.at("model_to_polycube_flipped").get<int>(),
-                           f.at("meets_contract").get<bool>() ? 0 : 1, f.at("eps_angle").get<double>());
-  };
+  auto rank = [&](const nlohmann::json& f) { return finished_rank(f); };
   for (size_t i = 0; i < finished.size(); ++i) {
     if (i + 1 < finished.size()) {
       EXPECT_FALSE(finished.at(i).at("meets_contract").get<bool>()) << "finishing stops at a map that meets it";
@@ -190,6 +197,51 @@ TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   EXPECT_EQ(tilted_faces(dir + "/polycube.obj", report_rotation(report)), 0);
   EXPECT_LT(map.at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
   EXPECT_EQ(read_polygon_soup(dir + "/model_on_polycube.obj").points.size(), read_polygon_soup(test::data_path("helmet.off")).points.size());
+}
+
+// When no finished map of the search's candidates meets the contract, the whole search runs again
+// with d_a divided by --finer-contours and its maps compete with the first ones. CGAL's eight
+// (genus 2, 1536 triangles) with the coarsest contours (--da 1), P's sampling unrefined and the
+// files not untangled misses 2 % of the area on every candidate (0.963–0.965); at d_a 1/3 its first
+// candidate meets the contract. With --finer-contours 1 the second search does not run.
+TEST(MapCli, AMapShortOfTheContractIsFinishedAgainWithFinerContours) {
+  const std::string coarse = "map --quiet --da 1 --no-refine --untangle-shift 0 " + quoted(test::data_path("eight.off"));
+  const std::string dir = test::temp_dir("map-finer");
+  const CliRun run = polycube_cli(coarse + " -o " + quoted(dir));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  const auto& finished = report.at("alignment").at("finished");
+  int first_pass = 0, kept = -1;
+  for (size_t i = 0; i < finished.size(); ++i) {
+    const auto& f = finished.at(i);
+    const bool finer = f.at("name").get<std::string>().find(", finer contours (d_a 0.333") != std::string::npos;
+    if (!finer) {
+      ++first_pass;
+      EXPECT_EQ(i, static_cast<size_t>(first_pass - 1)) << "the first search's maps come first";
+      EXPECT_FALSE(f.at("meets_contract").get<bool>()) << "the first search had a map meeting the contract: pick another case";
+    }
+    if (f.at("kept").get<bool>()) kept = static_cast<int>(i);
+  }
+  ASSERT_GE(first_pass, 1);
+  ASSERT_GT(finished.size(), static_cast<size_t>(first_pass)) << "no map with finer contours";
+  ASSERT_GE(kept, first_pass) << "the finer contours' map is kept";
+  for (const auto& f : finished) EXPECT_LE(finished_rank(finished.at(kept)), finished_rank(f));
+  EXPECT_TRUE(finished.at(kept).at("meets_contract").get<bool>());
+  EXPECT_EQ(report.at("alignment").at("chosen").get<std::string>(), finished.at(kept).at("name").get<std::string>());
+  EXPECT_TRUE(report.at("alignment").at("finer_contours").contains("candidates"));
+  EXPECT_NEAR(report.at("polycube").at("da").get<double>(), 1.0 / 3, 1e-12);
+  const auto& map = report.at("map");
+  EXPECT_EQ(map.at("polycube_to_model").at("flipped").get<int>() + map.at("model_to_polycube").at("flipped").get<int>(), 0);
+  EXPECT_NEAR(map.at("polycube_to_model").at("area_ratio").get<double>(), 1.0, 0.02);
+  EXPECT_EQ(tilted_faces(dir + "/polycube.obj", report_rotation(report)), 0);
+
+  const std::string once = test::temp_dir("map-finer-off");
+  const CliRun off = polycube_cli(coarse + " --finer-contours 1 -o " + quoted(once));
+  ASSERT_EQ(off.code, 0) << off.err;
+  const auto first = read_json(once + "/report.json");
+  EXPECT_FALSE(first.at("alignment").contains("finer_contours"));
+  EXPECT_DOUBLE_EQ(first.at("polycube").at("da").get<double>(), 1.0);
+  EXPECT_GT(std::abs(first.at("map").at("polycube_to_model").at("area_ratio").get<double>() - 1), 0.02);
 }
 
 // The last untangling of the files (image_untangle.h): on CGAL's rotor.off (1200 triangles), a
