@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -47,6 +48,8 @@ struct QuadCommandOptions {
   std::string preview_path;
   std::string align = "auto";
   int smooth_map_sweeps = 0;
+  // Quads that still fall short are tried once more with d_a divided by this (as `map` does); 1: never.
+  double finer_contours = 3;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -155,6 +158,8 @@ nlohmann::json quality_json(const QuadQuality& q) {
 // Hausdorff distance, then that distance; the next candidate is tried while worth_retrying.
 // candidate -1: --align none or --map.
 struct QuadAttempt : AlignedStages {
+  std::string name;         // orientation (and finer contours)
+  PolycubeOptions polycube_options;  // what its polycube is built with
   TriMesh aligned;  // the model turned by rotation
   std::optional<QuadRemeshResult> result;
   double smooth_map_seconds = 0, seconds = 0;
@@ -196,7 +201,6 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // The map P → M: from the directory, or built now (one orientation at a time: the search's
   // winner, then, while the quads fall short, its next candidates; see below).
   std::optional<MapFromDirectory> from_directory;
-  Alignment alignment;
   QuadRemeshOptions remesh;
   remesh.grid.cell_size = options.cell_size;
   remesh.grid.target_quads = options.target_faces;
@@ -215,13 +219,19 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     progress.stage("map", "reading " + options.map_dir);
     from_directory = read_map_directory(options.map_dir, projector, progress);
     auto a = std::make_unique<QuadAttempt>();
+    a->name = options.map_dir;
     a->result = remesh_quads(from_directory->polycube, from_directory->to_model, *projector, remesh, report_stage);
     attempts.push_back(std::move(a));
   } else {
     report["parameters"]["dz"] = options.topology.dz;
     report["parameters"]["da"] = options.polycube.da;
-    // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
-    // images are turned back into the input's frame.
+    report["parameters"]["align"] = options.align;
+    report["parameters"]["finer_contours"] = options.finer_contours;
+  }
+  // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
+  // images are turned back into the input's frame. One search's candidates become attempts.
+  const auto add_attempts = [&](const PolycubeOptions& polycube, nlohmann::json& alignment_report, const std::string& suffix) {
+    Alignment alignment;
     if (options.align == "auto" || options.align == "corners") {
       AlignmentOptions align_options;
       if (options.align == "corners") align_options.mapped_candidates = 0;
@@ -229,20 +239,23 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                                   ? "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 2 with fewest corners (the rest if both flip), scored by flips"
                                   : "orientations (input frame, principal axes, normal axes): the polycube with the fewest corners");
       const double align_start = progress.elapsed_seconds();
-      alignment = choose_alignment(model, options.topology, options.polycube, align_options);
-      seconds["align"] = progress.elapsed_seconds() - align_start;
+      alignment = choose_alignment(model, options.topology, polycube, align_options);
+      seconds["align"] = seconds.value("align", 0.0) + progress.elapsed_seconds() - align_start;
       if (alignment.proxy_faces > 0)
         progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
       if (alignment.chosen < 0)
         throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
-      progress.stage("align", alignment.candidates[alignment.chosen].name);
+      alignment_report["chosen"] = alignment.candidates[alignment.chosen].name + suffix;
+      progress.stage("align", alignment.candidates[alignment.chosen].name + suffix);
     }
-    report["parameters"]["align"] = options.align;
     for (const AlignedStages& stages : alignment.stages_in_order()) {
       attempts.push_back(std::make_unique<QuadAttempt>());
       static_cast<AlignedStages&>(*attempts.back()) = stages;
+      attempts.back()->name = (stages.candidate >= 0 ? alignment.candidates[stages.candidate].name : std::string("input frame")) + suffix;
+      attempts.back()->polycube_options = polycube;
     }
-  }
+  };
+  if (options.map_dir.empty()) add_attempts(options.polycube, report["alignment"], "");
   // The map stages one orientation still needs, then its quads.
   const auto remesh_with = [&](QuadAttempt& a) {
     const double start = progress.elapsed_seconds();
@@ -250,7 +263,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
     if (!a.topology) a.topology = std::make_shared<TopologyResult>(analyse_topology(a.aligned, options.topology));
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
-    if (!a.polycube) a.polycube = std::make_shared<PolycubeResult>(build_polycube(a.aligned, *a.topology, options.polycube));
+    if (!a.polycube) a.polycube = std::make_shared<PolycubeResult>(build_polycube(a.aligned, *a.topology, a.polycube_options));
     for (const std::string& repair : a.polycube->repairs) progress.warning("polycube: " + repair);
     progress.stage("polycube", std::to_string(a.polycube->polycube.corners.size()) + " corners, " +
                                    std::to_string(a.polycube->polycube.faces.size()) + " faces");
@@ -279,15 +292,35 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     a.seconds = progress.elapsed_seconds() - start;
   };
   QuadAttempt* kept = nullptr;
-  for (std::unique_ptr<QuadAttempt>& attempt : attempts) {
-    QuadAttempt& a = *attempt;
-    if (kept)
-      progress.stage("retry", "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
-                                  percent(kept->result->quality.hausdorff_percent) +
-                                  " % Hausdorff); the next orientation candidate, " + alignment.candidates[a.candidate].name);
-    if (!a.result) remesh_with(a);
-    if (!kept || a.rank() < kept->rank()) kept = &a;
-    if (!kept->worth_retrying()) break;
+  const auto remesh_from = [&](size_t first) {
+    for (size_t i = first; i < attempts.size(); ++i) {
+      QuadAttempt& a = *attempts[i];
+      if (kept)
+        progress.stage("retry", "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
+                                    percent(kept->result->quality.hausdorff_percent) + " % Hausdorff); " + a.name);
+      if (!a.result) remesh_with(a);
+      if (!kept || a.rank() < kept->rank()) kept = &a;
+      if (!kept->worth_retrying()) break;
+    }
+  };
+  remesh_from(0);
+  // Still short: the search once more with finer contours, as `map` does (a thin part that d_a
+  // drops from P is squeezed by the map, and the quads carried through it cut across it).
+  if (kept->worth_retrying() && options.map_dir.empty() && options.finer_contours > 1) {
+    PolycubeOptions finer = options.polycube;
+    finer.da = options.polycube.da / options.finer_contours;
+    std::ostringstream suffix;
+    suffix << ", finer contours (d_a " << finer.da << ")";
+    progress.stage("retry", "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
+                                percent(kept->result->quality.hausdorff_percent) + " % Hausdorff); all over again with d_a " +
+                                std::to_string(finer.da));
+    const size_t first = attempts.size();
+    try {
+      add_attempts(finer, report["alignment"]["finer_contours"], suffix.str());
+      remesh_from(first);
+    } catch (const Error& e) {
+      progress.warning(std::string("finer contours: ") + e.what());
+    }
   }
   if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;
@@ -295,7 +328,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     for (const std::unique_ptr<QuadAttempt>& a : attempts) {
       if (!a->result) continue;
       if (a.get() != kept) retry_seconds += a->seconds;
-      tried.push_back({{"name", alignment.candidates[a->candidate].name},
+      tried.push_back({{"name", a->name},
                        {"quads", a->result->quality.quads},
                        {"flipped", a->result->quality.flipped_quads},
                        {"degenerate", a->result->quality.degenerate_quads},
@@ -305,9 +338,10 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     }
     report["alignment"]["tried"] = tried;
     seconds["retry"] = retry_seconds;
-    if (kept->candidate != alignment.chosen) progress.stage("retry", "kept " + alignment.candidates[kept->candidate].name);
+    if (kept != attempts.front().get()) progress.stage("retry", "kept " + kept->name);
   }
-  if (kept->candidate >= 0) report["alignment"]["chosen"] = alignment.candidates[kept->candidate].name;
+  if (kept->candidate >= 0) report["alignment"]["chosen"] = kept->name;
+  if (kept->topology) report["parameters"]["da_kept"] = kept->polycube_options.da;
   if (kept->topology) {
     seconds["topology"] = kept->topology->seconds_total;
     seconds["polycube"] = kept->polycube->seconds_total;
@@ -463,6 +497,11 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
   command->add_option("--da", options->polycube.da, "Area tolerance of the axis-aligned contours (paper's d_a; not with --map)")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));
+  command->add_option("--finer-contours", options->finer_contours,
+                      "When the quads of every orientation tried still fall short (flipped, or beyond 0.5 % of the diagonal), "
+                      "try again with d_a divided by this (not with --map); 1: never")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 100.0));
   command->callback([options, &global, &runner] { runner = [options, &global] { return run_quad(*options, global); }; });
 }
 

@@ -137,6 +137,52 @@ TEST(QuadCli, QuadsThatFallShortTryTheNextOrientations) {
   EXPECT_GT(report["seconds"]["retry"].get<double>(), 0.0);
 }
 
+// Quads of every orientation still short of the bound: the search runs once more with d_a divided
+// by --finer-contours, and its quads compete with the first ones. Eight at 200 quads without
+// refinement is beyond 0.5 % of the diagonal on every try of the first search (at d_a 0.1 its
+// first try comes within it, 0.48 %); with --finer-contours 1 the second search does not run.
+TEST(QuadCli, QuadsStillShortTryFinerContours) {
+  const std::string dir = test::temp_dir("quad-finer");
+  const std::string out = dir + "/eight.obj", report_path = dir + "/report.json";
+  const std::string coarse = "quad " + quoted(test::data_path("eight.off")) + " --target-faces 200 --refine 0 --refine-bound 0 --quiet";
+  const test::CliRun run = polycube_cli(coarse + " -o " + quoted(out) + " --report " + quoted(report_path));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
+  const nlohmann::json& tried = report["alignment"]["tried"];
+  size_t first = 0, finer = 0;
+  int kept = -1;
+  for (size_t i = 0; i < tried.size(); ++i) {
+    const bool is_finer = tried[i]["name"].get<std::string>().find(", finer contours (d_a 0.1)") != std::string::npos;
+    if (is_finer) {
+      ++finer;
+    } else {
+      EXPECT_EQ(finer, 0u) << "the first search's tries come first";
+      EXPECT_GT(tried[i]["hausdorff_percent"].get<double>(), 0.5) << "a first try met the bound: pick a coarser case";
+      ++first;
+    }
+    if (tried[i]["kept"].get<bool>()) kept = static_cast<int>(i);
+  }
+  EXPECT_GE(first, 1u);
+  ASSERT_GE(finer, 1u);
+  ASSERT_GE(kept, 0);
+  auto rank = [](const nlohmann::json& t) {
+    return std::make_tuple(t["flipped"].get<int>() + t["degenerate"].get<int>(), t["hausdorff_percent"].get<double>());
+  };
+  for (const nlohmann::json& t : tried) EXPECT_LE(rank(tried[kept]), rank(t));
+  EXPECT_EQ(report["alignment"]["chosen"], tried[kept]["name"]);
+  EXPECT_TRUE(report["alignment"]["finer_contours"].contains("chosen"));
+  const bool kept_finer = static_cast<size_t>(kept) >= first;
+  EXPECT_DOUBLE_EQ(report["parameters"]["da_kept"].get<double>(), kept_finer ? 0.1 : 0.3);
+  EXPECT_EQ(quad_topology(read_quads(out)).genus(), 2);
+
+  const std::string once = dir + "/once.json";
+  ASSERT_EQ(polycube_cli(coarse + " --finer-contours 1 -o " + quoted(dir + "/once.obj") + " --report " + quoted(once)).code, 0);
+  const nlohmann::json first_only = nlohmann::json::parse(test::read_file(once));
+  EXPECT_FALSE(first_only["alignment"].contains("finer_contours"));
+  for (const nlohmann::json& t : first_only["alignment"]["tried"])
+    EXPECT_EQ(t["name"].get<std::string>().find("finer contours"), std::string::npos);
+}
+
 TEST(QuadCli, CleanErrors) {
   const std::string dir = test::temp_dir("quad-cli");
   const std::string mesh = quoted(test::data_path("eight.off"));
@@ -147,6 +193,7 @@ TEST(QuadCli, CleanErrors) {
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-target 0").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-bound -0.1").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-bound-growth 0.9").code, 2);
+  EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --finer-contours 0.5").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --map " + quoted(dir + "/none")).code, 3);
   EXPECT_EQ(polycube_cli("quad " + quoted(test::data_path("bad/open-cube.off")) + " -o " + quoted(dir + "/q.obj")).code, 4);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/missing/q.obj")).code, 5);

@@ -318,6 +318,9 @@ TEST(MapCli, BadInputFailsCleanlyAndWritesNothing) {
 
   run = polycube_cli("map --quiet " + quoted(test::data_path("sphere.off")) + " -o " + quoted(dir) + " --dz 0");
   EXPECT_EQ(run.code, 2) << run.err;
+  run = polycube_cli("map --quiet " + quoted(test::data_path("sphere.off")) + " -o " + quoted(dir) + " --finer-contours 0.5");
+  EXPECT_EQ(run.code, 2) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir));
   run = polycube_cli("map --quiet " + quoted(test::data_path("sphere.off")));
   EXPECT_EQ(run.code, 2) << "-o is required";
 }
