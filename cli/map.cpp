@@ -48,8 +48,8 @@ struct MapOptions {
   bool refine = true;
   // The last untangling's largest move of an image, × the target's diagonal; 0: none.
   double untangle_shift = ImageUntangleOptions().max_shift;
-  // A finished map that misses the contract is tried once more with d_a divided by this (the
-  // kept orientation, finer contours); 1: never.
+  // When no finished map of the orientation search meets the contract, the search and its maps
+  // run once more with d_a divided by this (finer contours); 1: never.
   double finer_contours = 3;
   TopologyOptions topology;
   PolycubeOptions polycube;
@@ -158,7 +158,7 @@ struct Attempt : AlignedStages {
   nlohmann::json refinement_report = nullptr;
   double refine_seconds = 0, smooth_unrefined_seconds = 0, seconds = 0;
   std::string name;  // orientation (and finer contours)
-  double da = 0;     // the d_a its polycube was built with, when a second pass ran
+  double da = 0;     // the d_a its polycube was built with
 };
 
 nlohmann::json polycube_json(const PolycubeResult& result) {
@@ -434,6 +434,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       attempts.push_back(std::make_unique<Attempt>());
       static_cast<AlignedStages&>(*attempts.back()) = stages;
       attempts.back()->name = (stages.candidate >= 0 ? alignment.candidates[stages.candidate].name : std::string("input frame")) + suffix;
+      attempts.back()->da = pass.polycube.da;
     }
     if (first_choice.empty()) first_choice = attempts[first]->name;
     for (size_t i = first; i < attempts.size(); ++i) {
@@ -467,14 +468,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     progress.stage("retry", "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " + std::to_string(kept->finished->bad_m()) +
                                 " flipped, image area " + std::to_string(kept->finished->audit.polycube_to_model.area_ratio) +
                                 "; all over again with d_a " + std::to_string(finer.polycube.da));
-    for (size_t i = 0; i < attempts.size(); ++i) attempts[i]->da = options.polycube.da;
-    const size_t first = attempts.size();
     try {
       run_pass(finer, report["alignment"]["finer_contours"], suffix.str());
     } catch (const Error& e) {
       progress.warning(std::string("finer contours: ") + e.what());
     }
-    for (size_t i = first; i < attempts.size(); ++i) attempts[i]->da = finer.polycube.da;
   }
   const Attempt& chosen = *kept;
   const Eigen::Matrix3d rotation = chosen.rotation;
@@ -528,7 +526,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   if (polycube) {
     model_pieces = &polycube->model_sliced;
     report["polycube"] = polycube_json(*polycube);
-    report["polycube"]["da"] = chosen.da > 0 ? chosen.da : options.polycube.da;
+    report["polycube"]["da"] = chosen.da;
     seconds["polycube"] = polycube->seconds_total;
     written_polycube = &polycube->polycube;
   }
