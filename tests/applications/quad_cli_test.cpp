@@ -140,12 +140,13 @@ TEST(QuadCli, QuadsThatFallShortTryTheNextOrientations) {
 // Quads of every orientation still short of the bound: the search runs once more with d_a divided
 // by --finer-contours, and its quads compete with the first ones. Eight at 200 quads without
 // refinement is beyond 0.5 % of the diagonal on every try of the first search (at d_a 0.1 its
-// first try comes within it, 0.48 %); with --finer-contours 1 the second search does not run.
+// first try comes within it, 0.48 %, with more quads than the cap below, so the cap is lifted
+// here); with --finer-contours 1 the second search does not run.
 TEST(QuadCli, QuadsStillShortTryFinerContours) {
   const std::string dir = test::temp_dir("quad-finer");
   const std::string out = dir + "/eight.obj", report_path = dir + "/report.json";
   const std::string coarse = "quad " + quoted(test::data_path("eight.off")) + " --target-faces 200 --refine 0 --refine-bound 0 --quiet";
-  const test::CliRun run = polycube_cli(coarse + " -o " + quoted(out) + " --report " + quoted(report_path));
+  const test::CliRun run = polycube_cli(coarse + " --refine-bound-growth 100 -o " + quoted(out) + " --report " + quoted(report_path));
   ASSERT_EQ(run.code, 0) << run.err;
   const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
   const nlohmann::json& tried = report["alignment"]["tried"];
@@ -174,6 +175,16 @@ TEST(QuadCli, QuadsStillShortTryFinerContours) {
   const bool kept_finer = static_cast<size_t>(kept) >= first;
   EXPECT_DOUBLE_EQ(report["parameters"]["da_kept"].get<double>(), kept_finer ? 0.1 : 0.3);
   EXPECT_EQ(quad_topology(read_quads(out)).genus(), 2);
+
+  // With the default --refine-bound-growth (3), a try of the second search with more than 3 ×
+  // 200 quads is not kept.
+  const std::string capped = dir + "/capped.json";
+  ASSERT_EQ(polycube_cli(coarse + " -o " + quoted(dir + "/capped.obj") + " --report " + quoted(capped)).code, 0);
+  const nlohmann::json capped_report = nlohmann::json::parse(test::read_file(capped));
+  for (const nlohmann::json& t : capped_report["alignment"]["tried"]) {
+    const bool is_finer = t["name"].get<std::string>().find("finer contours") != std::string::npos;
+    if (t["kept"].get<bool>() && is_finer) EXPECT_LE(t["quads"].get<int>(), 600);
+  }
 
   const std::string once = dir + "/once.json";
   ASSERT_EQ(polycube_cli(coarse + " --finer-contours 1 -o " + quoted(dir + "/once.obj") + " --report " + quoted(once)).code, 0);
