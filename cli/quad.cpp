@@ -161,6 +161,7 @@ nlohmann::json quality_json(const QuadQuality& q) {
 struct QuadAttempt : AlignedStages {
   std::string name;         // orientation (and finer contours)
   PolycubeOptions polycube_options;  // what its polycube is built with
+  long long max_quads = 0;           // a larger grid fails the try early (0: the grid's default)
   TriMesh aligned;  // the model turned by rotation
   std::optional<QuadRemeshResult> result;
   double smooth_map_seconds = 0, seconds = 0;
@@ -289,7 +290,9 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
         return rotation.transpose() * surface_position(aligned, map.to_model(p));
       };
     }
-    a.result = remesh_quads(P, to_model, *projector, remesh, report_stage);
+    QuadRemeshOptions try_options = remesh;
+    if (a.max_quads > 0) try_options.grid.max_quads = a.max_quads;
+    a.result = remesh_quads(P, to_model, *projector, try_options, report_stage);
     a.seconds = progress.elapsed_seconds() - start;
   };
   QuadAttempt* kept = nullptr;
@@ -299,11 +302,22 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       if (kept)
         progress.stage("retry", "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
                                     percent(kept->result->quality.hausdorff_percent) + " % Hausdorff); " + a.name);
-      if (!a.result) remesh_with(a);
       // A finer P's layout can need many more quads than asked (spool: 104 368 for 10 000, at
-      // 0.538 % against 0.705 %): such a try of the second search is not kept.
-      const bool oversized = first > 0 && options.cell_size <= 0 &&
-                             a.result->quality.quads > options.refine_bound_growth * options.target_faces;
+      // 0.538 % against 0.705 %, 4 minutes): a try of the second search with more than
+      // refine_bound_growth × target_faces quads is not kept, and one whose grid is half as
+      // large again is given up as soon as the grid is laid out.
+      const bool capped = first > 0 && options.cell_size <= 0;
+      if (capped) a.max_quads = static_cast<long long>(1.5 * options.refine_bound_growth * options.target_faces);
+      if (!a.result) {
+        try {
+          remesh_with(a);
+        } catch (const AlgorithmError& e) {
+          if (!capped) throw;
+          progress.warning(a.name + ": " + e.what());
+          continue;
+        }
+      }
+      const bool oversized = capped && a.result->quality.quads > options.refine_bound_growth * options.target_faces;
       if (!oversized && (!kept || a.rank() < kept->rank())) kept = &a;
       if (!kept->worth_retrying()) break;
     }
