@@ -407,6 +407,10 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   Attempt* kept = nullptr;
   double align_seconds = 0;
   std::string first_choice;  // the first search's orientation
+  const auto shortfall = [&]() {
+    return "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " + std::to_string(kept->finished->bad_m()) +
+           " flipped, image area " + std::to_string(kept->finished->audit.polycube_to_model.area_ratio) + "; ";
+  };
   auto run_pass = [&](const MapOptions& pass, nlohmann::json& alignment_report, const std::string& suffix) {
     Alignment alignment;
     if (pass.align == "auto" && pass.stage != "topology") {
@@ -439,11 +443,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     if (first_choice.empty()) first_choice = attempts[first]->name;
     for (size_t i = first; i < attempts.size(); ++i) {
       Attempt& a = *attempts[i];
-      if (kept) {
-        progress.stage("retry", "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " +
-                                    std::to_string(kept->finished->bad_m()) + " flipped, image area " +
-                                    std::to_string(kept->finished->audit.polycube_to_model.area_ratio) + "; finishing " + a.name);
-      }
+      if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
       run_stages(a, prepared.mesh, pass, progress);
       if (!a.finished) {
         kept = &a;
@@ -465,9 +465,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     finer.polycube.da = options.polycube.da / options.finer_contours;
     std::ostringstream suffix;
     suffix << ", finer contours (d_a " << finer.polycube.da << ")";
-    progress.stage("retry", "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " + std::to_string(kept->finished->bad_m()) +
-                                " flipped, image area " + std::to_string(kept->finished->audit.polycube_to_model.area_ratio) +
-                                "; all over again with d_a " + std::to_string(finer.polycube.da));
+    progress.stage("retry", shortfall() + "all over again with d_a " + std::to_string(finer.polycube.da));
     try {
       run_pass(finer, report["alignment"]["finer_contours"], suffix.str());
     } catch (const Error& e) {

@@ -161,7 +161,8 @@ nlohmann::json quality_json(const QuadQuality& q) {
 struct QuadAttempt : AlignedStages {
   std::string name;         // orientation (and finer contours)
   PolycubeOptions polycube_options;  // what its polycube is built with
-  long long max_quads = 0;           // a larger grid fails the try early (0: the grid's default)
+  long long max_quads = 0;           // a larger grid gives the try up (0: the grid's default)
+  std::string given_up;              // why it was given up (no result)
   TriMesh aligned;  // the model turned by rotation
   std::optional<QuadRemeshResult> result;
   double smooth_map_seconds = 0, seconds = 0;
@@ -296,28 +297,27 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     a.seconds = progress.elapsed_seconds() - start;
   };
   QuadAttempt* kept = nullptr;
+  const auto shortfall = [&]() {
+    return "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
+           percent(kept->result->quality.hausdorff_percent) + " % Hausdorff); ";
+  };
+  // A capped try (max_quads > 0) that fails is given up, one with more than refine_bound_growth
+  // × target_faces quads is not kept.
   const auto remesh_from = [&](size_t first) {
     for (size_t i = first; i < attempts.size(); ++i) {
       QuadAttempt& a = *attempts[i];
-      if (kept)
-        progress.stage("retry", "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
-                                    percent(kept->result->quality.hausdorff_percent) + " % Hausdorff); " + a.name);
-      // A finer P's layout can need many more quads than asked (spool: 104 368 for 10 000, at
-      // 0.538 % against 0.705 %, 4 minutes): a try of the second search with more than
-      // refine_bound_growth × target_faces quads is not kept, and one whose grid is half as
-      // large again is given up as soon as the grid is laid out.
-      const bool capped = first > 0 && options.cell_size <= 0;
-      if (capped) a.max_quads = static_cast<long long>(1.5 * options.refine_bound_growth * options.target_faces);
+      if (kept) progress.stage("retry", shortfall() + a.name);
       if (!a.result) {
         try {
           remesh_with(a);
         } catch (const AlgorithmError& e) {
-          if (!capped) throw;
-          progress.warning(a.name + ": " + e.what());
+          if (a.max_quads == 0) throw;
+          a.given_up = e.what();
+          progress.warning(a.name + ": " + a.given_up);
           continue;
         }
       }
-      const bool oversized = capped && a.result->quality.quads > options.refine_bound_growth * options.target_faces;
+      const bool oversized = a.max_quads > 0 && a.result->quality.quads > options.refine_bound_growth * options.target_faces;
       if (!oversized && (!kept || a.rank() < kept->rank())) kept = &a;
       if (!kept->worth_retrying()) break;
     }
@@ -330,12 +330,16 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     finer.da = options.polycube.da / options.finer_contours;
     std::ostringstream suffix;
     suffix << ", finer contours (d_a " << finer.da << ")";
-    progress.stage("retry", "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
-                                percent(kept->result->quality.hausdorff_percent) + " % Hausdorff); all over again with d_a " +
-                                std::to_string(finer.da));
+    progress.stage("retry", shortfall() + "all over again with d_a " + std::to_string(finer.da));
     const size_t first = attempts.size();
     try {
       add_attempts(finer, report["alignment"]["finer_contours"], suffix.str());
+      // A finer P's layout can need many more quads than asked (spool: 104 368 for 10 000, at
+      // 0.538 % against 0.705 %, 4 minutes): such tries are capped (not kept above the growth
+      // the refinement may reach, given up when the grid alone is half as large again).
+      if (options.cell_size <= 0)
+        for (size_t i = first; i < attempts.size(); ++i)
+          attempts[i]->max_quads = static_cast<long long>(1.5 * options.refine_bound_growth * options.target_faces);
       remesh_from(first);
     } catch (const Error& e) {
       progress.warning(std::string("finer contours: ") + e.what());
@@ -359,9 +363,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     seconds["retry"] = retry_seconds;
     if (kept != attempts.front().get()) progress.stage("retry", "kept " + kept->name);
   }
+  nlohmann::json given_up = nlohmann::json::array();
+  for (const std::unique_ptr<QuadAttempt>& a : attempts)
+    if (!a->given_up.empty()) given_up.push_back({{"name", a->name}, {"why", a->given_up}});
+  if (!given_up.empty()) report["alignment"]["given_up"] = given_up;
   if (kept->candidate >= 0) report["alignment"]["chosen"] = kept->name;
-  if (kept->topology) report["parameters"]["da_kept"] = kept->polycube_options.da;
   if (kept->topology) {
+    report["parameters"]["da_kept"] = kept->polycube_options.da;
     seconds["topology"] = kept->topology->seconds_total;
     seconds["polycube"] = kept->polycube->seconds_total;
     seconds["map"] = kept->map->seconds;
