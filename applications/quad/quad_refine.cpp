@@ -66,30 +66,10 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
                           const PreimageLocator& locator, double distance, double cell_size, int threads) {
   const TriMesh& surface = model.surface();
   const SurfaceProjector on_quads(triangulate_quads(quads));
-  // Points of M: its vertices, then the centroids of its triangles longer than a quarter cell
-  // and points along its edges longer than that, at most a quarter cell apart (a coarse CAD
-  // mesh is missed between its vertices, along its creases); each with a vertex of M whose
-  // closest point starts its search.
-  std::vector<Eigen::Vector3d> samples;
-  std::vector<int> hint_vertex;
-  samples.reserve(surface.num_vertices());
-  for (int v = 0; v < surface.num_vertices(); ++v) samples.push_back(surface.V.row(v).transpose());
-  const double spacing = cell_size / 4;
-  for (int f = 0; f < surface.num_faces(); ++f) {
-    const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)), b = surface.V.row(surface.F(f, 1)), c = surface.V.row(surface.F(f, 2));
-    if (std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}) <= spacing) continue;
-    samples.push_back((a + b + c) / 3);
-    hint_vertex.push_back(surface.F(f, 0));
-  }
-  const EdgeMap edges = build_edge_map(surface.F);
-  for (int e = 0; e < edges.num_edges(); ++e) {
-    const Eigen::Vector3d a = surface.V.row(edges.E(e, 0)), b = surface.V.row(edges.E(e, 1));
-    const int parts = static_cast<int>(std::ceil((b - a).norm() / spacing));
-    for (int k = 1; k < parts; ++k) {
-      samples.push_back(a + (b - a) * (static_cast<double>(k) / parts));
-      hint_vertex.push_back(edges.E(e, 0));
-    }
-  }
+  // Points of M (its vertices, centroids of long triangles, points along long edges, a quarter
+  // cell apart).
+  const SurfaceSamples sampled = sample_surface(surface, cell_size / 4);
+  const std::vector<Eigen::Vector3d>& samples = sampled.points;
   // Points of the quads, on M and on P: centres, and midpoints of edges (each once).
   std::vector<Eigen::Vector3d> quad_points, quad_points_on_p;
   for (int q = 0; q < quads.num_quads(); ++q) {
@@ -107,7 +87,7 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
       quad_points_on_p.push_back((grid.mesh.V.row(u) + grid.mesh.V.row(w)).transpose() / 2);
     }
   }
-  const int nv = surface.num_vertices(), ns = static_cast<int>(samples.size()), nq = static_cast<int>(quad_points.size());
+  const int ns = static_cast<int>(samples.size()), nq = static_cast<int>(quad_points.size());
   // Per candidate: its distance and its point of P (set when a miss).
   std::vector<double> miss(ns + nq, 0);
   std::vector<SurfacePoint> where(ns + nq);
@@ -119,9 +99,7 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
   // vertices in breadth-first order): a walk's distance is never below the true one, so only the
   // points it leaves beyond `distance` need the whole search (most need none: a walk is many
   // times faster).
-  std::vector<SurfaceHit> near = closest_to_vertices(on_quads, surface, true);
-  near.resize(ns);
-  for (int k = nv; k < ns; ++k) near[k] = on_quads.closest_on_sheet(samples[k], near[hint_vertex[k - nv]]);
+  const std::vector<SurfaceHit> near = closest_to_samples(on_quads, surface, sampled, true);
   parallel_range(ns + nq, threads, [&](int k) {
     if (k < ns) {
       miss[k] = near[k].distance;

@@ -135,7 +135,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
                         " refused (would flip a quad or leave the surface under the vertex)");
     }
     if (options.fit.passes > 0) {
-      say("fit", "corners pulled onto the model's vertices the quads miss");
+      say("fit", "corners pulled onto the points of the model the quads miss (vertices, creases)");
       begin = std::chrono::steady_clock::now();
       pass.fitting = fit_quads(pass.mesh, model, options.fit, fitted);
       pass.mesh = std::move(pass.fitting.mesh);
@@ -150,7 +150,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         pass.refitting.mesh = QuadMesh{};
       }
       pass.seconds_fit += since(begin);
-      say("fit", std::to_string(pass.fitting.snapped) + " corners pulled, farthest model vertex " +
+      say("fit", std::to_string(pass.fitting.snapped) + " corners pulled, farthest model point " +
                      format("%.4g -> %.4g from the quads", pass.fitting.farthest_before, pass.fitting.farthest_after));
     }
     if (options.untangle.passes > 0) {

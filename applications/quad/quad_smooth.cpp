@@ -462,16 +462,21 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   std::vector<int> quad_state(mesh.num_quads());
   for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
 
-  // Distance of every model vertex from the quads (two triangles each, split as the measure
-  // splits them) and the quad it is closest to; per quad, the model vertices closest to it.
-  std::vector<double> distance(model.num_vertices(), 0);
-  std::vector<int> owner(model.num_vertices(), -1);
+  // The model's points to fit (vertices, and along long edges a quarter of the mean quad size
+  // apart: creases of a coarse CAD mesh), the distance of every one from the quads (two triangles
+  // each, split as the measure splits them) and the quad it is closest to; per quad, the points
+  // closest to it.
+  const SurfaceSamples samples = sample_surface(model, size / 4);
+  const std::vector<Eigen::Vector3d>& points = samples.points;
+  const int np = static_cast<int>(points.size());
+  std::vector<double> distance(np, 0);
+  std::vector<int> owner(np, -1);
   std::vector<std::vector<int>> owned(mesh.num_quads());
   auto measure_all = [&]() {
     const SurfaceProjector triangles(triangulate_quads(mesh));
     for (auto& list : owned) list.clear();
-    const std::vector<SurfaceHit> hits = closest_to_vertices(triangles, model, false);
-    for (int w = 0; w < model.num_vertices(); ++w) {
+    const std::vector<SurfaceHit> hits = closest_to_samples(triangles, model, samples, false);
+    for (int w = 0; w < np; ++w) {
       const SurfaceHit& hit = hits[w];
       distance[w] = hit.distance;
       owner[w] = hit.face / 2;
@@ -508,9 +513,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   std::vector<std::pair<int, double>> moved_to;
   std::vector<SurfaceHit> after_hit;
   for (int pass = 0; pass < options.passes; ++pass) {
-    // The model vertices beyond the tolerance, farthest first.
+    // The model's points beyond the tolerance, farthest first.
     std::vector<int> far;
-    for (int w = 0; w < model.num_vertices(); ++w)
+    for (int w = 0; w < np; ++w)
       if (distance[w] > tolerance) far.push_back(w);
     if (far.empty()) break;
     ++result.passes;
@@ -519,7 +524,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     int snapped = 0;
     for (const int w : far) {
       if (!(distance[w] > tolerance)) continue;  // an earlier pull covered it
-      const Eigen::Vector3d x = model.V.row(w);
+      const Eigen::Vector3d& x = points[w];
       // The nearest corner of the quad the vertex is closest to, within reach.
       int v = -1;
       double best = options.reach * size;
@@ -576,7 +581,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
         recheck.clear();
         for (int q : around[v]) recheck.insert(recheck.end(), owned[q].begin(), owned[q].end());
         for (size_t i = 0; i < recheck.size() && accepted; ++i) {
-          const Eigen::Vector3d y = model.V.row(recheck[i]);
+          const Eigen::Vector3d& y = points[recheck[i]];
           int nearest = -1;
           double d = INFINITY;
           for (int r : nearby) {

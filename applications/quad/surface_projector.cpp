@@ -215,6 +215,44 @@ std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, con
   return hits;
 }
 
+SurfaceSamples sample_surface(const TriMesh& surface, double spacing) {
+  if (!(spacing > 0)) throw std::invalid_argument("surface samples: spacing must be > 0, got " + std::to_string(spacing));
+  SurfaceSamples samples;
+  samples.points.reserve(surface.num_vertices());
+  for (int v = 0; v < surface.num_vertices(); ++v) {
+    samples.points.push_back(surface.V.row(v).transpose());
+    samples.hint_vertex.push_back(v);
+  }
+  for (int f = 0; f < surface.num_faces(); ++f) {
+    const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)), b = surface.V.row(surface.F(f, 1)), c = surface.V.row(surface.F(f, 2));
+    if (std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()}) <= spacing) continue;
+    samples.points.push_back((a + b + c) / 3);
+    samples.hint_vertex.push_back(surface.F(f, 0));
+  }
+  const EdgeMap edges = build_edge_map(surface.F);
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    const Eigen::Vector3d a = surface.V.row(edges.E(e, 0)), b = surface.V.row(edges.E(e, 1));
+    const int parts = static_cast<int>(std::ceil((b - a).norm() / spacing));
+    for (int k = 1; k < parts; ++k) {
+      samples.points.push_back(a + (b - a) * (static_cast<double>(k) / parts));
+      samples.hint_vertex.push_back(edges.E(e, 0));
+    }
+  }
+  return samples;
+}
+
+std::vector<SurfaceHit> closest_to_samples(const SurfaceProjector& surface, const TriMesh& sampled, const SurfaceSamples& samples,
+                                           bool on_sheet) {
+  std::vector<SurfaceHit> hits = closest_to_vertices(surface, sampled, on_sheet);
+  const int nv = sampled.num_vertices(), n = static_cast<int>(samples.points.size());
+  hits.resize(n);
+  for (int k = nv; k < n; ++k) {
+    const SurfaceHit& hint = hits[samples.hint_vertex[k]];
+    hits[k] = on_sheet ? surface.closest_on_sheet(samples.points[k], hint) : surface.closest(samples.points[k], hint);
+  }
+  return hits;
+}
+
 const TriMesh& SurfaceProjector::surface() const { return impl_->surface; }
 
 Eigen::Vector3d SurfaceProjector::face_normal(int f) const { return impl_->normals.row(f); }

@@ -62,4 +62,21 @@ class SurfaceProjector {
 // walks of closest_on_sheet alone (never nearer than the exact answer; many times faster).
 std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, const TriMesh& points, bool on_sheet);
 
+// Points of a surface a coarser mesh on it must come near: its vertices first (point v is vertex
+// v), then the centroids of its triangles longer than `spacing` and points along its edges longer
+// than that, at most `spacing` apart (a coarse CAD mesh is missed between its vertices, along its
+// creases). hint_vertex: per point, a vertex of the surface next to it (point v: v itself), whose
+// closest point may start the point's search.
+struct SurfaceSamples {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> hint_vertex;
+};
+// Throws std::invalid_argument for spacing <= 0.
+SurfaceSamples sample_surface(const TriMesh& surface, double spacing);
+
+// The closest points on `surface` of all the samples: the vertices as closest_to_vertices does,
+// the other points each from its hint vertex's result (exact, or with on_sheet the walks).
+std::vector<SurfaceHit> closest_to_samples(const SurfaceProjector& surface, const TriMesh& sampled, const SurfaceSamples& samples,
+                                           bool on_sheet);
+
 }  // namespace polycube
