@@ -2,7 +2,6 @@
 
 #include "polycube/closest_point.h"
 #include "polycube/errors.h"
-#include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
 
 #include <algorithm>

@@ -462,8 +462,8 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   std::vector<int> quad_state(mesh.num_quads());
   for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
 
-  // The model's points to fit (vertices, and along long edges a quarter of the mean quad size
-  // apart: creases of a coarse CAD mesh), the distance of every one from the quads (two triangles
+  // The model's points to fit (vertices, centroids of long triangles, points along long edges a
+  // quarter of the mean quad size apart: creases of a coarse CAD mesh), the distance of every one from the quads (two triangles
   // each, split as the measure splits them) and the quad it is closest to; per quad, the points
   // closest to it.
   const SurfaceSamples samples = sample_surface(model, size / 4);
@@ -525,7 +525,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     for (const int w : far) {
       if (!(distance[w] > tolerance)) continue;  // an earlier pull covered it
       const Eigen::Vector3d& x = points[w];
-      // The nearest corner of the quad the vertex is closest to, within reach.
+      // The nearest corner of the quad the point is closest to, within reach.
       int v = -1;
       double best = options.reach * size;
       for (int k = 0; k < 4; ++k) {

@@ -90,18 +90,18 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
 // Fitting the quads to the model's extremities. A uniform grid relaxed towards even squares puts
 // its vertices anywhere along the model, so tips, fins, sharp corners and creases of the model fall
 // inside quads that cut across them: that is where the Hausdorff distance of the quads comes from.
-// Here the model's points (sample_surface: its vertices, and points along its edges longer than a
-// quarter of the mean quad size, that far apart, so a coarse CAD mesh's creases too) farther than
-// `tolerance` × the model's bounding-box diagonal from the quads (two triangles each, as the
-// measure splits them) pull, farthest first, the nearest corner of the quad they are closest to
-// onto themselves: only a corner within `reach` × the mean quad size, not already pulled, whose
-// edges stay above 2 % of the mean quad size, under the relaxation's guard (no corner or quad of
-// the vertex's quads turns against the surface that did not before), bending no corner of its
-// quads beyond max_corner_deviation from 90°, moving its quads off the model (sampled at edge
-// midpoints and triangle centres) no farther than the tolerance or than before, and uncovering
-// nothing: the model's points closest to the vertex's quads must stay within the farthest
-// distance of the pass. So the farthest model point never gets farther. Pulled vertices are
-// pinned. Passes repeat while vertices are pulled.
+// Here the model's points (sample_surface: its vertices, the centroids of its triangles and points
+// along its edges longer than a quarter of the mean quad size, that far apart, so a coarse CAD
+// mesh's creases too) farther than `tolerance` × the model's bounding-box diagonal from the quads
+// (two triangles each, as the measure splits them) pull, farthest first, the nearest corner of the
+// quad they are closest to onto themselves: only a corner within `reach` × the mean quad size, not
+// already pulled, whose edges stay above 2 % of the mean quad size, under the relaxation's guard
+// (no corner or quad of the vertex's quads turns against the surface that did not before), bending
+// no corner of its quads beyond max_corner_deviation from 90°, moving its quads off the model
+// (sampled at edge midpoints and triangle centres) no farther than the tolerance or than before,
+// and uncovering nothing: the model's points closest to the vertex's quads must stay within the
+// farthest distance of the pass. So the farthest model point never gets farther. Pulled vertices
+// are pinned. Passes repeat while vertices are pulled.
 struct QuadFitOptions {
   int passes = 4;
   double tolerance = 0.002;
@@ -112,7 +112,7 @@ struct QuadFitOptions {
 };
 
 //   mesh       the fitted quads (same connectivity)
-//   pinned     per vertex: pulled onto a model vertex
+//   pinned     per vertex: pulled onto a point of the model
 //   snapped    vertices pulled; passes run (including an undone one)
 //   farthest_before, farthest_after  largest distance of a model point from the quads, input
 //              units (after <= before)
