@@ -463,10 +463,10 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
 
   // The model's points to fit (vertices, centroids of long triangles, points along long edges a
-  // quarter of the mean quad size apart: creases of a coarse CAD mesh), the distance of every one from the quads (two triangles
-  // each, split as the measure splits them) and the quad it is closest to; per quad, the points
-  // closest to it.
-  const SurfaceSamples samples = sample_surface(model, size / 4);
+  // quarter of the mean quad size apart: creases of a coarse CAD mesh; the vertices alone when
+  // every quad collapsed), the distance of every one from the quads (two triangles each, split as
+  // the measure splits them) and the quad it is closest to; per quad, the points closest to it.
+  const SurfaceSamples samples = sample_surface(model, size > 0 ? size / 4 : INFINITY);
   const std::vector<Eigen::Vector3d>& points = samples.points;
   const int np = static_cast<int>(points.size());
   std::vector<double> distance(np, 0);

@@ -71,7 +71,7 @@ struct SurfaceSamples {
   std::vector<Eigen::Vector3d> points;
   std::vector<int> hint_vertex;
 };
-// Throws std::invalid_argument for spacing <= 0.
+// spacing may be +infinity (the vertices alone). Throws std::invalid_argument for spacing <= 0.
 SurfaceSamples sample_surface(const TriMesh& surface, double spacing);
 
 // The closest points on `surface` of all the samples: the vertices as closest_to_vertices does,
