@@ -583,7 +583,6 @@ TEST(QuadCarry, FitPullsACornerOntoATip) {
   EXPECT_THROW(fit_quads(quads, model, bad), std::invalid_argument);
 }
 
-}  // namespace
 // The fit on a coarse CAD model: a cube of 12 triangles turned against the grid, so the quads
 // (the cube-sphere's, sent onto the cube from its centre) cut across its 90° creases between its
 // vertices. The points along the creases pull quad corners onto the creases, not only the cube's
@@ -595,9 +594,9 @@ TEST(QuadCarry, FitPullsCornersOntoCreasesOfACoarseModel) {
   box.V = (box.V * turn.transpose()).eval();
   const SurfaceProjector model(box);
   QuadMesh quads = c.quads;
-  for (int v = 0; v < quads.num_vertices(); ++v) {
+  for (int v = 0; v < quads.num_vertices(); ++v) {  // where the ray from the centre meets the cube
     const Eigen::Vector3d d = quads.V.row(v).transpose().normalized();
-    quads.V.row(v) = (d / (turn.transpose() * d).cwiseAbs().maxCoeff()).transpose();  // the ray from the centre meets the cube
+    quads.V.row(v) = (d / (turn.transpose() * d).cwiseAbs().maxCoeff()).transpose();
   }
   const QuadQuality before = measure_quads(quads, model, c.grid.corners);
   ASSERT_EQ(before.flipped_quads, 0);
@@ -646,4 +645,5 @@ TEST(QuadCarry, SurfaceSamplesAlongLongEdges) {
   EXPECT_THROW(sample_surface(box, 0), std::invalid_argument);
 }
 
+}  // namespace
 }  // namespace polycube
