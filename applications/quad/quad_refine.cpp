@@ -94,16 +94,13 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
   // that cuts across it), where the preimage through the chords may lie off the quads' lines.
   std::vector<SurfacePoint> under_quad(ns);
   const TriMesh& quad_triangles = on_quads.surface();
-  // The model's points first on the quads' sheet, walking from a neighbour's closest point (the
-  // vertices in breadth-first order): a walk's distance is never below the true one, so only the
-  // points it leaves beyond `distance` need the whole search (most need none: a walk is many
-  // times faster).
-  const std::vector<SurfaceHit> near = closest_to_samples(on_quads, surface, sampled, true);
+  // The model's points on the quads' sheet by walks (many times faster than the tree), the whole
+  // search only for those a walk leaves beyond `distance` (a walk is never nearer than the closest
+  // point).
+  const std::vector<SurfaceHit> near = closest_to_samples(on_quads, surface, sampled, distance, threads);
   parallel_range(ns + nq, threads, [&](int k) {
     if (k < ns) {
-      miss[k] = near[k].distance;
-      if (miss[k] <= distance) return;
-      const SurfaceHit hit = on_quads.closest(samples[k], near[k]);
+      const SurfaceHit& hit = near[k];
       miss[k] = hit.distance;
       if (miss[k] > distance) {
         where[k] = locator.preimage(samples[k]);

@@ -475,11 +475,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   auto measure_all = [&]() {
     const SurfaceProjector triangles(triangulate_quads(mesh));
     for (auto& list : owned) list.clear();
-    // Walks on the quads' sheet first (never nearer than the closest point), the whole search
-    // only for the points they leave beyond the tolerance: which points are far is exact.
-    std::vector<SurfaceHit> hits = closest_to_samples(triangles, model, samples, true);
+    // Exact for the points beyond the tolerance (which points are far is exact), walks elsewhere.
+    const std::vector<SurfaceHit> hits = closest_to_samples(triangles, model, samples, tolerance);
     for (int w = 0; w < np; ++w) {
-      if (hits[w].distance > tolerance) hits[w] = triangles.closest(points[w], hits[w]);
       const SurfaceHit& hit = hits[w];
       distance[w] = hit.distance;
       owner[w] = hit.face / 2;

@@ -2,6 +2,7 @@
 
 #include "polycube/closest_point.h"
 #include "polycube/mesh_topology.h"
+#include "polycube/parallel.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -242,14 +243,14 @@ SurfaceSamples sample_surface(const TriMesh& surface, double spacing) {
 }
 
 std::vector<SurfaceHit> closest_to_samples(const SurfaceProjector& surface, const TriMesh& sampled, const SurfaceSamples& samples,
-                                           bool on_sheet) {
-  std::vector<SurfaceHit> hits = closest_to_vertices(surface, sampled, on_sheet);
+                                           double exact_beyond, int threads) {
+  std::vector<SurfaceHit> hits = closest_to_vertices(surface, sampled, true);
   const int nv = sampled.num_vertices(), n = static_cast<int>(samples.points.size());
   hits.resize(n);
-  for (int k = nv; k < n; ++k) {
-    const SurfaceHit& hint = hits[samples.hint_vertex[k]];
-    hits[k] = on_sheet ? surface.closest_on_sheet(samples.points[k], hint) : surface.closest(samples.points[k], hint);
-  }
+  for (int k = nv; k < n; ++k) hits[k] = surface.closest_on_sheet(samples.points[k], hits[samples.hint_vertex[k]]);
+  parallel_range(n, threads, [&](int k) {
+    if (!(hits[k].distance <= exact_beyond)) hits[k] = surface.closest(samples.points[k], hits[k]);
+  });
   return hits;
 }
 

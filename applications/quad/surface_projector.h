@@ -74,9 +74,13 @@ struct SurfaceSamples {
 // spacing may be +infinity (the vertices alone). Throws std::invalid_argument for spacing <= 0.
 SurfaceSamples sample_surface(const TriMesh& surface, double spacing);
 
-// The closest points on `surface` of all the samples: the vertices as closest_to_vertices does,
-// the other points each from its hint vertex's result (exact, or with on_sheet the walks).
+// The closest points on `surface` of all the samples: walks on the sheet (closest_on_sheet; the
+// vertices in breadth-first order as closest_to_vertices takes them, the other points each from
+// its hint vertex's result), then, on `threads` threads (0: one per hardware thread), the whole
+// search for the points a walk leaves farther than `exact_beyond`. So which points lie beyond
+// it is exact, and their hits are; 0: every hit exact; +infinity: the walks alone (never nearer
+// than the exact answer).
 std::vector<SurfaceHit> closest_to_samples(const SurfaceProjector& surface, const TriMesh& sampled, const SurfaceSamples& samples,
-                                           bool on_sheet);
+                                           double exact_beyond, int threads = 1);
 
 }  // namespace polycube

@@ -639,7 +639,7 @@ TEST(QuadCarry, SurfaceSamplesAlongLongEdges) {
   }
   // Their closest points on the cube itself: every one at distance 0.
   const SurfaceProjector on_box(box);
-  for (const SurfaceHit& hit : closest_to_samples(on_box, box, samples, true)) EXPECT_LE(hit.distance, 1e-12);
+  for (const SurfaceHit& hit : closest_to_samples(on_box, box, samples, INFINITY)) EXPECT_LE(hit.distance, 1e-12);
   EXPECT_EQ(sample_surface(box, 3).points.size(), 8u) << "nothing longer than the spacing";
   EXPECT_EQ(sample_surface(box, INFINITY).points.size(), 8u) << "the vertices alone";
   EXPECT_THROW(sample_surface(box, 0), std::invalid_argument);
