@@ -43,6 +43,7 @@ struct QuadCommandOptions {
   double refine_growth = 1.3;
   double refine_bound = 0.5;
   double refine_bound_growth = 3;
+  int refine_templates = 4;
   bool fit = true;
   std::string report_path;
   std::string preview_path;
@@ -198,6 +199,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                           {"refine_growth", options.refine_growth},
                           {"refine_bound", options.refine_bound},
                           {"refine_bound_growth", options.refine_bound_growth},
+                          {"refine_templates", options.refine_templates},
                           {"map", options.map_dir.empty() ? nlohmann::json() : nlohmann::json(options.map_dir)}};
   nlohmann::json seconds = {{"read", progress.elapsed_seconds()}};
 
@@ -213,6 +215,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   remesh.refine.max_growth = options.refine_growth;
   remesh.refine.bound_percent = options.refine_bound;
   remesh.refine.bound_growth = options.refine_bound_growth;
+  remesh.refine.template_rounds = options.refine_templates;
   remesh.carry.threads = 0;  // both maps only read; interpolation and closest points are thread-safe
   remesh.refine.threads = remesh.carry.threads;
   if (!options.fit) remesh.fit.passes = 0;
@@ -436,6 +439,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                       {"layout_cells", grid.layout.num_quads()},
                       {"chords", grid.chords},
                       {"refine_rounds", result.refine_rounds},
+                      {"template_rounds", result.template_rounds},
                       {"refined_chord_parts", grid.refined_parts},
                       {"miss_before_refinement", result.refine_miss_before},
                       {"miss_after_refinement", result.refine_miss_after}};
@@ -463,7 +467,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
 
 void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner& runner) {
   auto options = std::make_shared<QuadCommandOptions>();
-  CLI::App* command = app.add_subcommand("quad", "All-quad remesh from the polycube map (irregular only at polycube corners)");
+  CLI::App* command = app.add_subcommand("quad", "All-quad remesh from the polycube map (irregular only at polycube corners, unless quads had to be split locally to meet --refine-bound)");
   add_mesh_input_options(*command, options->input);
   command->add_option("-o,--output", options->output, "Output quad mesh (.obj .ply .off)")
       ->required()
@@ -506,6 +510,12 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
                       "The most quads the refinement may add to meet --refine-bound, as a factor of the uniform grid's")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
+  command->add_option("--refine-templates", options->refine_templates,
+                      "When the quads still miss the model by more than --refine-bound after that: up to this many rounds "
+                      "splitting only the quads at the misses (3 x 3, with transition quads round them: adds irregular "
+                      "vertices off the polycube's corners; at most 1.5 times the quads in all); 0: never")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 20));
   command->add_flag("--no-fit{false}", options->fit,
                    "Do not pull quad corners onto the model's tips and edges the quads miss (the fit, after the relaxation)");
   command->add_option("--report", options->report_path, "Write the quality report as JSON to this file");

@@ -99,10 +99,13 @@ std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid
 RefinedCarry carry_refined_grid(const PolycubeGrid& grid, const SurfaceMap& map, const PolycubeGrid& from, const QuadMesh& quads,
                                 const SurfaceProjector& model, const CarryOptions& options) {
   if (quads.Q != from.mesh.Q) throw std::invalid_argument("the finished quads do not have the refined grid's connectivity");
-  RefinedCarry carried{carry_grid(grid, map, options), same_grid_vertices(from, grid)};
+  const bool through_map = static_cast<bool>(map);
+  RefinedCarry carried{through_map ? carry_grid(grid, map, options) : QuadMesh{Eigen::MatrixX3d::Zero(grid.mesh.num_vertices(), 3), grid.mesh.Q},
+                       same_grid_vertices(from, grid)};
   QuadMesh& mesh = carried.mesh;
-  // How far the relaxation and the fit moved each vertex of `from` from its image.
-  const Eigen::MatrixX3d moved = quads.V - carry_grid(from, map, options).V;
+  // How far the relaxation and the fit moved each vertex of `from` from its image (without a
+  // map: from the origin, so that the shift is the interpolated position itself).
+  const Eigen::MatrixX3d moved = through_map ? Eigen::MatrixX3d(quads.V - carry_grid(from, map, options).V) : quads.V;
   const SurfaceProjector on_from(triangulate_quads(from.mesh));
   const TriMesh& t = on_from.surface();
   for (int v = 0; v < mesh.num_vertices(); ++v) {

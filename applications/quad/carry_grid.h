@@ -50,8 +50,10 @@ std::vector<int> same_grid_vertices(const PolycubeGrid& from, const PolycubeGrid
 // relaxed and fitted; same connectivity as `from`); each added one at its image under the map
 // (so it reaches what the old quads cut across), shifted as the vertices of `from` round it
 // were shifted from their images (barycentric in from's quads on P, as triangulate_quads splits
-// them), then placed on `model` by closest point. Throws std::invalid_argument when quads do not
-// have from's connectivity; what carry_grid throws.
+// them), then placed on `model` by closest point. An empty map: each added vertex where from's
+// quads are on M at its place (the same barycentric interpolation of their positions), then on
+// `model` by closest point (the quads split as they are, without the map). Throws
+// std::invalid_argument when quads do not have from's connectivity; what carry_grid throws.
 //   mesh  the carried grid
 //   same  same_grid_vertices(from, grid)
 struct RefinedCarry {

@@ -51,6 +51,13 @@ struct QuadRefineOptions {
   // held), kept only if the quads then flip nothing more and miss the model no farther or within
   // 0.9 × bound_percent; 0: none.
   int polish_sweeps = 15;
+  // When the quads still miss the model by more than bound_percent after all that: up to this
+  // many rounds of template refinement (quad_templates.h: only the quads at the misses are split,
+  // with transitions round them; irregular vertices off P's corners), all of them together up to
+  // template_growth times the quads they start from; a round is kept when it misses less and
+  // flips nothing more. 0: none.
+  int template_rounds = 4;
+  double template_growth = 1.5;
   // Threads for the distance queries and the map's values at P's vertices (the map must then be
   // thread-safe); 0: one per hardware thread, 1: the calling thread.
   int threads = 1;

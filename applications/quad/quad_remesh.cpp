@@ -1,5 +1,7 @@
 #include "applications/quad/quad_remesh.h"
 
+#include "applications/quad/quad_templates.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -66,9 +68,10 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
 
   // One pass: carry the grid, relax, fit.
   // A refinement round's pass (from: the quads it refines) starts where from's relaxation and fit
-  // left the vertices it keeps, the added ones carried by the map (carry_refined_grid), and
+  // left the vertices it keeps, the added ones carried by the map (carry_refined_grid; without
+  // through_map, as template rounds do, placed on from's quads where they split them), and
   // relaxes with fewer sweeps (QuadRefineOptions::warm_sweeps).
-  const auto run_pass = [&](QuadRemeshResult& pass, bool quiet, const QuadRemeshResult* from) {
+  const auto run_pass = [&](QuadRemeshResult& pass, bool quiet, const QuadRemeshResult* from, bool through_map = true) {
     QuadSmoothOptions smooth = options.smooth;
     const bool warm = from && options.refine.warm_sweeps > 0;
     if (warm) smooth.sweeps = std::min(smooth.sweeps, options.refine.warm_sweeps);
@@ -79,7 +82,8 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
     auto begin = std::chrono::steady_clock::now();
     std::vector<int> same;  // per vertex, the vertex of from's grid at its place (-1: none)
     if (warm) {
-      RefinedCarry carried = carry_refined_grid(pass.grid, to_model, from->grid, from->mesh, model, options.carry);
+      RefinedCarry carried =
+          carry_refined_grid(pass.grid, through_map ? to_model : SurfaceMap(), from->grid, from->mesh, model, options.carry);
       pass.mesh = std::move(carried.mesh);
       same = std::move(carried.same);
     } else {
@@ -380,9 +384,87 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         result.refine_miss_after = after.farthest;
       }
     }
+    if (options.refine.template_rounds > 0 && bound > 0 && result.refine_miss_after > bound) {
+      // Still beyond the bound: the quads at the misses split by templates (quad_templates.h),
+      // which spend quads only there, at the price of irregular vertices off P's corners.
+      QuadMiss at = find_quad_misses(result.grid, result.mesh, model, locator, goal, result.grid.cell_size, options.refine.threads);
+      const auto budget = static_cast<long long>(options.refine.template_growth * result.grid.mesh.num_quads());
+      for (int round = 0; round < options.refine.template_rounds && at.farthest > bound; ++round) {
+        const SurfaceProjector on_grid(triangulate_quads(result.grid.mesh));
+        // The places' quads on P (the worst first).
+        const Eigen::MatrixX4i& Q = result.grid.mesh.Q;
+        std::vector<int> place_quads;
+        for (size_t k = 0; k < at.points.size() && at.distances[k] > bound; ++k)
+          place_quads.push_back(on_grid.closest(surface_position(polycube, at.points[k])).face / 2);
+        std::vector<char> dropped(place_quads.size(), 0);
+        // A pass from the places not dropped: their quads' corners marked, the worse half of them
+        // again while that is over budget; false when nothing fits.
+        QuadRemeshResult pass;
+        std::vector<int> parents;
+        QuadMiss next;
+        std::pair<int, int> pass_bad;
+        const auto attempt = [&]() {
+          std::vector<int> taken;
+          for (size_t k = 0; k < place_quads.size(); ++k)
+            if (!dropped[k]) taken.push_back(place_quads[k]);
+          pass = QuadRemeshResult{};
+          for (size_t take = taken.size(); take > 0 && pass.grid.mesh.num_quads() == 0; take /= 2) {
+            std::vector<char> marked(result.grid.mesh.num_vertices(), 0);
+            for (size_t k = 0; k < take; ++k)
+              for (int c = 0; c < 4; ++c) marked[Q(taken[k], c)] = 1;
+            PolycubeGrid grid = refine_grid_by_templates(
+                result.grid, std::move(marked), [&](const Eigen::Vector3d& x) { return locator.on_polycube(x); }, &parents);
+            if (grid.mesh.num_quads() <= budget) pass.grid = std::move(grid);
+          }
+          if (pass.grid.mesh.num_quads() == 0) return false;
+          run_pass(pass, true, &result, false);
+          next = find_quad_misses(pass.grid, pass.mesh, model, locator, goal, pass.grid.cell_size, options.refine.threads);
+          pass_bad = bad(pass);
+          return true;
+        };
+        bool made = attempt();
+        // New quads flipped (the split quads bend round a crease or a fold of the quads): the places
+        // whose quads touch the quads split into them are dropped, and the round made again.
+        for (int again = 0; made && pass_bad.first > best_bad.first && again < 3; ++again) {
+          std::vector<char> near(result.grid.mesh.num_vertices(), 0);
+          const int old_vertices = result.grid.mesh.num_vertices();
+          for (int q : bad_quads(pass.mesh, model, options.quality)) {
+            bool split = false;
+            for (int c = 0; c < 4; ++c) split = split || pass.grid.mesh.Q(q, c) >= old_vertices;
+            if (split)
+              for (int c = 0; c < 4; ++c) near[Q(parents[q], c)] = 1;
+          }
+          int newly = 0;
+          for (size_t k = 0; k < place_quads.size(); ++k) {
+            bool touches = false;
+            for (int c = 0; c < 4; ++c) touches = touches || near[Q(place_quads[k], c)];
+            if (touches && !dropped[k]) {
+              dropped[k] = 1;
+              ++newly;
+            }
+          }
+          if (newly == 0) break;
+          report("refine", "templates " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
+                               " flipped or degenerate quads; again without the " + std::to_string(newly) + " places next to them");
+          made = attempt();
+        }
+        if (!made) break;
+        const bool better = pass_bad.first <= best_bad.first && next.farthest < result.refine_miss_after;
+        report("refine", "templates " + std::to_string(round + 1) + ": " + std::to_string(pass.grid.mesh.num_quads()) +
+                             " quads, misses by up to " + format("%.3f %%", 100 * next.farthest / diagonal) + ", " +
+                             std::to_string(pass_bad.first) + " flipped or degenerate quads" + (better ? "" : ": not kept"));
+        if (!better) break;
+        take_pass(result, std::move(pass));
+        result.refine_miss_after = next.farthest;
+        result.template_rounds = round + 1;
+        best_bad = pass_bad;
+        at = next;
+      }
+    }
     result.seconds_refine = since(begin);
     report("refine", std::to_string(result.refine_rounds) + " rounds kept, " + std::to_string(result.grid.refined_parts) +
-                         " chord parts halved, " + std::to_string(result.grid.mesh.num_quads()) + " quads, farthest miss " +
+                         " chord parts halved, " + std::to_string(result.template_rounds) + " template rounds, " +
+                         std::to_string(result.grid.mesh.num_quads()) + " quads, farthest miss " +
                          format("%.3f -> %.3f %% of the diagonal", 100 * result.refine_miss_before / diagonal,
                                 100 * result.refine_miss_after / diagonal));
   }

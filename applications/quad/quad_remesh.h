@@ -18,6 +18,10 @@
 //                                               without flipping more is kept; past the rounds
 //                                               and budget asked for, more of both while beyond
 //                                               the bound (QuadRefineOptions)
+//   still beyond the bound: template rounds      the quads at the misses split 3 x 3 with
+//           (quad_templates.h)                   transitions round them (irregular vertices off
+//                                                P's corners), the new vertices placed on the
+//                                                quads they split, relaxed round them, fitted
 //   quality = measure_quads(quads, M, corners)
 #pragma once
 
@@ -71,6 +75,7 @@ struct QuadRemeshResult {
   PolycubeGrid grid;
   QuadMesh mesh;
   int refine_rounds = 0;
+  int template_rounds = 0;  // template refinement rounds kept (QuadRefineOptions::template_rounds)
   double refine_miss_before = 0;
   double refine_miss_after = 0;
   QuadSmoothResult smoothing;

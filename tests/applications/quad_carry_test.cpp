@@ -232,6 +232,7 @@ TEST(QuadCarry, RemeshPipeline) {
   QuadRemeshOptions options;
   options.grid.target_quads = 2000;
   options.smooth.sweeps = 2;
+  options.refine.template_rounds = 0;  // the grid's own vertices: irregular at P's corners alone
   const QuadRemeshResult r = remesh_quads(P, [&](const SurfacePoint& p) { return on_mesh(P, p); }, surface, options);
   EXPECT_EQ(r.mesh.Q, r.grid.mesh.Q);
   EXPECT_EQ(r.smoothing.sweeps, 2);
@@ -339,6 +340,41 @@ TEST(QuadCarry, RefinementGoesOnToTheBound) {
   EXPECT_EQ(bounded.quality.flipped_quads, 0);
   EXPECT_EQ(bounded.quality.irregular_vertices, 8);
   EXPECT_TRUE(bounded.quality.topology.closed_manifold());
+}
+
+// The templates: when the chord rounds and their budgets are spent with the quads still beyond the
+// bound, the quads at the misses are split (3 x 3 with transitions round them) and the quads come
+// nearer, with only the quads there added (at most template_growth times), still closed,
+// all-quad, nothing flipped, on the model, irregular at the cube's corners and, now, at the
+// transitions too.
+TEST(QuadCarry, TemplatesTakeTheQuadsNearerWhereChordsRanOut) {
+  QuadRemeshOptions options = horn_options(1500, 1);
+  options.refine.max_growth = 1.05;
+  options.refine.bound_percent = 0.5;
+  options.refine.bound_growth = 1.05;
+  options.refine.template_rounds = 0;
+  const QuadRemeshResult chords = remesh_horn(options);
+  options.refine.template_rounds = 4;
+  const QuadRemeshResult templates = remesh_horn(options);
+  const double diagonal = templates.quality.diagonal;
+  ASSERT_GT(chords.refine_miss_after, 0.0045 * diagonal) << "the chords' budget leaves the horn beyond the bound";
+  EXPECT_EQ(chords.template_rounds, 0);
+  EXPECT_EQ(chords.quality.irregular_vertices, 8);
+  EXPECT_GE(templates.template_rounds, 1);
+  // Measured: 0.83 % -> 0.22 % of the diagonal, 1472 -> 1588 quads, 50 irregular vertices, one
+  // round (the chord rounds with 2x the quads: 0.20 % with 2904, RefinementReachesIntoAHorn).
+  EXPECT_LT(templates.refine_miss_after, 0.8 * chords.refine_miss_after);
+  EXPECT_LT(templates.quality.model_to_quads, chords.quality.model_to_quads);
+  EXPECT_GT(templates.quality.quads, chords.quality.quads);
+  EXPECT_LE(templates.quality.quads, options.refine.template_growth * chords.quality.quads);
+  EXPECT_TRUE(templates.quality.topology.closed_manifold());
+  EXPECT_EQ(templates.quality.genus, 0);
+  EXPECT_EQ(templates.quality.flipped_quads, 0);
+  EXPECT_EQ(templates.quality.degenerate_quads, 0);
+  EXPECT_EQ(templates.quality.irregular_at_corners, 8);
+  EXPECT_GT(templates.quality.irregular_vertices, 8);
+  EXPECT_LE(templates.quality.max_distance_to_surface, 1e-9 * diagonal);
+  EXPECT_EQ(templates.mesh.Q, templates.grid.mesh.Q);
 }
 
 // A warm round relaxes only round the lines it added: the vertices it shares with the quads it

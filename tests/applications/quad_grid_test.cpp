@@ -8,6 +8,7 @@
 #include "applications/quad/carry_grid.h"
 #include "applications/quad/polycube_grid.h"
 #include "applications/quad/quad_quality.h"
+#include "applications/quad/quad_templates.h"
 #include "applications/quad/surface_projector.h"
 
 #include "formats/mesh_io.h"
@@ -620,6 +621,97 @@ TEST(QuadGrid, PolycubesOfTestMeshes) {
     const std::set<int> at(grid.corner_polycube_vertex.begin(), grid.corner_polycube_vertex.end());
     for (int c : P.corners) EXPECT_TRUE(at.count(c)) << "polycube corner " << c << " regular";
     for (int c : at) EXPECT_TRUE(std::binary_search(P.vertices.begin(), P.vertices.end(), c)) << "vertex " << c;
+  }
+}
+
+// Template refinement (quad_templates.h) of the grid at marked vertices: still a closed, oriented,
+// connected all-quad manifold of P's Euler characteristic tiling P, every quad flat on P with its
+// parent's outward normal and positive area; old vertices keep their places; each quad split by
+// its marked corners (after the closure: none, one, two along an edge, all four) into 1, 3, 7 or
+// 9 quads; the new vertices' surface points reproduce them; a quad at a marked vertex is split
+// again by a second round, whose quads are a third of the size.
+TEST(QuadGrid, TemplatesRefineOnlyAtTheMarksAndConform) {
+  for (const Shape& shape : synthetic_shapes()) {
+    SCOPED_TRACE(shape.name);
+    const TriMesh& P = shape.mesh;
+    PolycubeGridOptions options;
+    options.target_quads = 300;
+    const PolycubeGrid base = build_polycube_grid(P, options);
+    const SurfaceProjector on_p(P);
+    const auto locate = [&](const Eigen::Vector3d& x) {
+      const SurfaceHit hit = on_p.closest(x);
+      const Eigen::Vector3d a = P.V.row(P.F(hit.face, 0)), b = P.V.row(P.F(hit.face, 1)), c = P.V.row(P.F(hit.face, 2));
+      const Eigen::Vector3d n = (b - a).cross(c - a);
+      const double area = n.squaredNorm();
+      SurfacePoint point;
+      point.face = hit.face;
+      point.bary = Eigen::Vector3d((b - hit.point).cross(c - hit.point).dot(n) / area, (c - hit.point).cross(a - hit.point).dot(n) / area, 0);
+      point.bary[2] = 1 - point.bary[0] - point.bary[1];
+      return point;
+    };
+    const double diagonal = bounding_box(P.V).diagonal();
+    // Every 7th vertex marked (isolated marks, pairs along edges and closures all occur).
+    std::vector<char> marked(base.mesh.num_vertices(), 0);
+    for (int v = 0; v < base.mesh.num_vertices(); v += 7) marked[v] = 1;
+    const std::vector<char> closed = close_template_marks(base.mesh.Q, marked);
+    const PolycubeGrid refined = refine_grid_by_templates(base, marked, locate);
+
+    const QuadTopology t = quad_topology(refined.mesh);
+    EXPECT_TRUE(t.closed_manifold());
+    EXPECT_EQ(t.components, 1);
+    EXPECT_EQ(t.euler, euler_characteristic(P.F, P.num_vertices()));
+    EXPECT_EQ(refined.mesh.V.topRows(base.mesh.num_vertices()), base.mesh.V);
+    EXPECT_EQ(refined.corners, base.corners);
+    ASSERT_EQ(refined.quad_axis.size(), refined.mesh.num_quads());
+    int expected_quads = 0, closure_left = 0;
+    for (int q = 0; q < base.mesh.num_quads(); ++q) {
+      int count = 0;
+      for (int k = 0; k < 4; ++k) count += closed[base.mesh.Q(q, k)];
+      const bool opposite = count == 2 && closed[base.mesh.Q(q, 0)] == closed[base.mesh.Q(q, 2)];
+      if (count == 3 || opposite) ++closure_left;
+      expected_quads += count == 0 ? 1 : count == 1 ? 3 : count == 2 ? 7 : 9;
+    }
+    EXPECT_EQ(closure_left, 0);
+    EXPECT_EQ(refined.mesh.num_quads(), expected_quads);
+    EXPECT_GT(refined.mesh.num_quads(), base.mesh.num_quads());
+    double area = 0;
+    int wrong_normal = 0, off_plane = 0;
+    for (int q = 0; q < refined.mesh.num_quads(); ++q) {
+      const int axis = std::abs(refined.quad_axis[q]) - 1;
+      Eigen::Vector3d p[4];
+      for (int k = 0; k < 4; ++k) p[k] = refined.mesh.V.row(refined.mesh.Q(q, k));
+      // Both triangles of the quad face outwards (so the quad is convex enough to have no fold).
+      const Eigen::Vector3d n1 = (p[1] - p[0]).cross(p[2] - p[0]), n2 = (p[2] - p[0]).cross(p[3] - p[0]);
+      const Eigen::Vector3d m1 = (p[2] - p[1]).cross(p[3] - p[1]), m2 = (p[3] - p[1]).cross(p[0] - p[1]);
+      if (n1[axis] * refined.quad_axis[q] <= 0 || n2[axis] * refined.quad_axis[q] <= 0) ++wrong_normal;
+      if (m1[axis] * refined.quad_axis[q] <= 0 || m2[axis] * refined.quad_axis[q] <= 0) ++wrong_normal;
+      for (int k = 1; k < 4; ++k)
+        if (std::abs(p[k][axis] - p[0][axis]) > 1e-12 * diagonal) ++off_plane;
+      area += (n1.norm() + n2.norm()) / 2;
+    }
+    EXPECT_EQ(wrong_normal, 0);
+    EXPECT_EQ(off_plane, 0);
+    EXPECT_NEAR(area, surface_area(P), 1e-9 * surface_area(P));
+    double error = 0;
+    for (int v = base.mesh.num_vertices(); v < refined.mesh.num_vertices(); ++v)
+      error = std::max(error, (surface_position(P, refined.on_polycube[v]) - refined.mesh.V.row(v).transpose()).norm());
+    EXPECT_LE(error, 1e-9 * diagonal);
+
+    // Again at one marked vertex of the refined grid: the quads round it a third of the size.
+    std::vector<char> again(refined.mesh.num_vertices(), 0);
+    again[0] = 1;
+    const PolycubeGrid twice = refine_grid_by_templates(refined, again, locate);
+    EXPECT_TRUE(quad_topology(twice.mesh).closed_manifold());
+    EXPECT_GT(twice.mesh.num_quads(), refined.mesh.num_quads());
+    const auto shortest_at_0 = [](const QuadMesh& m) {
+      double shortest = INFINITY;
+      for (int q = 0; q < m.num_quads(); ++q)
+        for (int k = 0; k < 4; ++k)
+          if (m.Q(q, k) == 0) shortest = std::min(shortest, (m.V.row(m.Q(q, (k + 1) % 4)) - m.V.row(0)).norm());
+      return shortest;
+    };
+    EXPECT_NEAR(shortest_at_0(twice.mesh), shortest_at_0(refined.mesh) / 3, 1e-9 * diagonal);
+    EXPECT_THROW(refine_grid_by_templates(refined, marked, locate), std::invalid_argument);
   }
 }
 
