@@ -423,17 +423,13 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
           return true;
         };
         bool made = attempt();
-        // New quads flipped (the split quads bend round a crease or a fold of the quads): the places
-        // whose quads touch the quads split into them are dropped, and the round made again.
+        // More quads flipped (split quads bent round a crease or a fold of the quads, or quads next
+        // to them moved by the relaxation): the places whose quads touch the quads the bad ones
+        // come from are dropped, and the round made again.
         for (int again = 0; made && pass_bad.first > best_bad.first && again < 3; ++again) {
           std::vector<char> near(result.grid.mesh.num_vertices(), 0);
-          const int old_vertices = result.grid.mesh.num_vertices();
-          for (int q : bad_quads(pass.mesh, model, options.quality)) {
-            bool split = false;
-            for (int c = 0; c < 4; ++c) split = split || pass.grid.mesh.Q(q, c) >= old_vertices;
-            if (split)
-              for (int c = 0; c < 4; ++c) near[Q(parents[q], c)] = 1;
-          }
+          for (int q : bad_quads(pass.mesh, model, options.quality))
+            for (int c = 0; c < 4; ++c) near[Q(parents[q], c)] = 1;
           int newly = 0;
           for (size_t k = 0; k < place_quads.size(); ++k) {
             bool touches = false;
