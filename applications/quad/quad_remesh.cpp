@@ -391,11 +391,15 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       const auto budget = static_cast<long long>(options.refine.template_growth * result.grid.mesh.num_quads());
       for (int round = 0; round < options.refine.template_rounds && at.farthest > bound; ++round) {
         const SurfaceProjector on_grid(triangulate_quads(result.grid.mesh));
-        // The places' quads on P (the worst first).
+        // The quads on P holding the misses beyond the bound, each once (the worst first).
         const Eigen::MatrixX4i& Q = result.grid.mesh.Q;
         std::vector<int> place_quads;
-        for (size_t k = 0; k < at.points.size() && at.distances[k] > bound; ++k)
-          place_quads.push_back(on_grid.closest(surface_position(polycube, at.points[k])).face / 2);
+        std::vector<char> placed(Q.rows(), 0);
+        for (size_t k = 0; k < at.points.size() && at.distances[k] > bound; ++k) {
+          const int q = on_grid.closest(surface_position(polycube, at.points[k])).face / 2;
+          if (!placed[q]) place_quads.push_back(q);
+          placed[q] = 1;
+        }
         std::vector<char> dropped(place_quads.size(), 0);
         // A pass from the places not dropped: their quads' corners marked, the worse half of them
         // again while that is over budget; false when nothing fits.
@@ -441,7 +445,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
           }
           if (newly == 0) break;
           report("refine", "templates " + std::to_string(round + 1) + ": " + std::to_string(pass_bad.first) +
-                               " flipped or degenerate quads; again without the " + std::to_string(newly) + " places next to them");
+                               " flipped or degenerate quads; again without the " + std::to_string(newly) + " quads next to them");
           made = attempt();
         }
         if (!made) break;

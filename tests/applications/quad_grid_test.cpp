@@ -12,6 +12,7 @@
 #include "applications/quad/surface_projector.h"
 
 #include "formats/mesh_io.h"
+#include "polycube/closest_point.h"
 #include "polycube/errors.h"
 #include "polycube/mesh_topology.h"
 #include "polycube/polycube_build.h"
@@ -639,14 +640,9 @@ TEST(QuadGrid, TemplatesRefineOnlyAtTheMarksAndConform) {
     const PolycubeGrid base = build_polycube_grid(P, options);
     const SurfaceProjector on_p(P);
     const auto locate = [&](const Eigen::Vector3d& x) {
-      const SurfaceHit hit = on_p.closest(x);
-      const Eigen::Vector3d a = P.V.row(P.F(hit.face, 0)), b = P.V.row(P.F(hit.face, 1)), c = P.V.row(P.F(hit.face, 2));
-      const Eigen::Vector3d n = (b - a).cross(c - a);
-      const double area = n.squaredNorm();
       SurfacePoint point;
-      point.face = hit.face;
-      point.bary = Eigen::Vector3d((b - hit.point).cross(c - hit.point).dot(n) / area, (c - hit.point).cross(a - hit.point).dot(n) / area, 0);
-      point.bary[2] = 1 - point.bary[0] - point.bary[1];
+      point.face = on_p.closest(x).face;
+      point.bary = closest_on_triangle(x, P.V.row(P.F(point.face, 0)), P.V.row(P.F(point.face, 1)), P.V.row(P.F(point.face, 2))).bary;
       return point;
     };
     const double diagonal = bounding_box(P.V).diagonal();
