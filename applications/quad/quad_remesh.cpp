@@ -388,7 +388,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       // Still beyond the bound: the quads at the misses split by templates (quad_templates.h),
       // which spend quads only there, at the price of irregular vertices off P's corners. Not
       // where quads are flipped already: a round could only be kept by flipping fewer, and on
-      // every such pass logged (camel, mpi, cow) the splits flipped more; they only cost time.
+      // every such pass logged (camel, mpi) the splits flipped more; they only cost time.
       QuadMiss at = find_quad_misses(result.grid, result.mesh, model, locator, goal, result.grid.cell_size, options.refine.threads);
       const auto budget = static_cast<long long>(options.refine.template_growth * result.grid.mesh.num_quads());
       for (int round = 0; round < options.refine.template_rounds && at.farthest > bound; ++round) {
