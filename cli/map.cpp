@@ -12,6 +12,7 @@
 #include "polycube/image_untangle.h"
 #include "polycube/polycube_build.h"
 #include "polycube/map_audit.h"
+#include "polycube/map_overlay.h"
 #include "polycube/map_quality.h"
 #include "polycube/map_refinement.h"
 #include "polycube/map_smoothing.h"
@@ -51,6 +52,9 @@ struct MapOptions {
   // When no finished map of the orientation search meets the contract, the search and its maps
   // run once more with d_a divided by this (finer contours); 1: never.
   double finer_contours = 3;
+  // When a finished map misses the contract, also the exact sampling of the unsmoothed map
+  // (map_overlay.h), kept if it ranks better.
+  bool exact = true;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -124,6 +128,9 @@ void write_map_preview(const std::string& path, const TriMesh& model, const Poly
 // The end of the map stage on one P: the smoothing, the second refinement, the audit.
 struct Finished {
   const Polycube* polycube = nullptr;
+  std::unique_ptr<Polycube> overlay_polycube;  // P triangulated by the overlay (exact_map), when that is P
+  nlohmann::json overlay = nullptr;
+  double overlay_seconds = 0;
   std::unique_ptr<MapRefinementResult> resampling;
   Eigen::MatrixX3d on_model_xyz, on_polycube_xyz;
   nlohmann::json smoothing = nullptr, resampling_report = nullptr, untangling = nullptr;
@@ -316,6 +323,40 @@ std::unique_ptr<Finished> finish_map(const TriMesh& model, const std::vector<dou
   return out;
 }
 
+// The exact sampling of φ (map_overlay.h): P triangulated by the common refinement of every
+// piece pair's two disk triangulations, on which φ is affine, so P's image tiles the model with
+// every triangle inside one model face, oriented as that face; the model's vertices at φ⁻¹
+// (vertices of that triangulation). Not smoothed (it is φ itself), untangled like any finished
+// map where the model's triangles, chords on P, still flip.
+std::unique_ptr<Finished> exact_map(const TriMesh& model, const Polycube& P, const PolycubeMap& map, const MapOptions& options,
+                                    const Progress& progress) {
+  const double start = progress.elapsed_seconds();
+  progress.stage("exact", "P triangulated by both disk triangulations of every piece: the map exact on each triangle");
+  const MapOverlay overlay = overlay_map(map);
+  auto out = std::make_unique<Finished>();
+  out->overlay_polycube = std::make_unique<Polycube>(P);
+  Polycube& R = *out->overlay_polycube;
+  R.mesh = overlay.polycube;
+  R.face_axis.resize(R.mesh.num_faces());
+  R.face_patch.resize(R.mesh.num_faces());
+  for (int f = 0; f < R.mesh.num_faces(); ++f) {
+    R.face_axis[f] = P.face_axis[overlay.face_parent[f]];
+    R.face_patch[f] = P.face_patch[overlay.face_parent[f]];
+  }
+  out->polycube = &R;
+  out->on_model_xyz = overlay.on_model_xyz;
+  out->on_polycube_xyz = map.model_on_polycube_xyz;
+  out->audit = audit_map(model, R.mesh, out->on_model_xyz, out->on_polycube_xyz);
+  out->overlay = {{"triangles", R.mesh.num_faces()}, {"vertices", R.mesh.num_vertices()}, {"cells", overlay.cells},
+                  {"collapsed", overlay.collapsed}, {"seconds", overlay.seconds}};
+  progress.stage("exact", std::to_string(R.mesh.num_faces()) + " triangles; " + std::to_string(out->bad_p()) + " / " +
+                              std::to_string(out->bad_m()) + " flipped or degenerate (P to M / M to P), image area " +
+                              std::to_string(out->audit.polycube_to_model.area_ratio));
+  untangle_images(model, *out, options.untangle_shift, progress);
+  out->overlay_seconds = progress.elapsed_seconds() - start;
+  return out;
+}
+
 // The stages of one orientation that the search did not build (all of them with --align none),
 // up to the stage asked; with the map, its refinement and finish. P's sampling of φ is refined
 // where its chords flip or lose area (issue 5) before the smoothing (φ itself at the new
@@ -375,6 +416,20 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
         a.refinement_report["kept"] = false;
         a.finished = std::move(refined);
       }
+    }
+    if (options.exact && a.finished && !a.finished->meets_contract()) {
+      std::unique_ptr<Finished> exact = exact_map(a.model, a.polycube->polycube, *a.map, options, progress);
+      const bool better = exact->rank() < a.finished->rank();
+      progress.stage("exact", std::string(better ? "kept" : "not kept") + " (" + std::to_string(exact->bad_p()) + " / " +
+                                  std::to_string(exact->bad_m()) + " against " + std::to_string(a.finished->bad_p()) + " / " +
+                                  std::to_string(a.finished->bad_m()) + ")");
+      exact->overlay["kept"] = better;
+      nlohmann::json tried = exact->overlay;
+      tried["polycube_to_model"] = direction_json(exact->audit.polycube_to_model);
+      tried["model_to_polycube"] = direction_json(exact->audit.model_to_polycube);
+      tried["seconds_total"] = exact->overlay_seconds;
+      if (better) a.finished = std::move(exact);
+      a.finished->overlay = tried;
     }
   }
   a.seconds = progress.elapsed_seconds() - start;
@@ -555,6 +610,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     if (chosen.smooth_unrefined_seconds > 0) seconds["smooth_unrefined"] = chosen.smooth_unrefined_seconds;
     if (options.smooth_sweeps > 0) seconds["smooth"] = finished.smooth_seconds;
     if (finished.untangle_seconds > 0) seconds["untangle"] = finished.untangle_seconds;
+    if (!finished.overlay.is_null()) seconds["exact"] = finished.overlay.value("seconds_total", 0.0);
     written_polycube = finished.polycube;
     const Polycube& P = *written_polycube;
     on_polycube_xyz = finished.on_polycube_xyz;
@@ -582,7 +638,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"area_max", audit.distortion.area_max},
                      {"refinement", chosen.refinement_report},
                      {"smoothing", finished.smoothing},
-                     {"untangling", finished.untangling}};
+                     {"untangling", finished.untangling},
+                     {"exact", finished.overlay}};
     TriMesh on_model = P.mesh;
     on_model.V = to_input(finished.on_model_xyz);
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
@@ -661,6 +718,9 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "divided by this (finer contours keep thin parts such as tails and horns); 1: never")
       ->check(CLI::Range(1.0, 100.0))
       ->capture_default_str();
+  command->add_flag("--no-exact{false}", options->exact,
+                   "When the finished map still has flipped triangles or misses area, do not try the exact sampling (P triangulated "
+                   "by both disk triangulations of every piece, where the unsmoothed map is affine on each triangle)");
   command->add_option("--stage", options->stage, "Stop after this stage")
       ->capture_default_str()
       ->check(CLI::IsMember(kStages));

@@ -14,7 +14,15 @@
 // the faces nearest its corners summing to nearly zero): the sign is then the residue of a
 // cancellation. The grid sees the faces the chord passes over. A chord reversed on one face, or
 // folded wrongly across an edge, faces away from every face near it and stays flipped.
+//
+// An image triangle that lies in one target face (its corners within a tolerance of that face's
+// triangle) is no chord: the target under it is that face, and it is judged by that face's
+// normal alone (face_holding). Neighbouring faces' normals would misjudge it next to a sharp
+// edge or a saddle vertex of a coarse target: an exact image of the overlay (map_overlay.h) in a
+// small face beside a large one at a dihedral angle under 90° faces away from their sum.
 #pragma once
+
+#include "polycube/closest_point.h"
 
 #include <Eigen/Core>
 
@@ -23,6 +31,25 @@
 #include <vector>
 
 namespace polycube {
+
+// Corners within this fraction of the target's bounding-box diagonal of a face lie in it.
+inline constexpr double kInFaceTolerance = 1e-9;
+
+// The face among fm, fa, fb, fc (the faces closest to the centroid and to a, b, c) whose
+// triangle holds all three corners to within `tolerance`, or -1. corners(f, k): corner k of
+// target face f.
+template <class Corners>
+int face_holding(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fm, int fa, int fb, int fc,
+                 const Corners& corners, double tolerance) {
+  for (const int f : {fm, fa, fb, fc}) {
+    if (f < 0) continue;
+    const Eigen::Vector3d p = corners(f, 0), q = corners(f, 1), r = corners(f, 2);
+    bool holds = true;
+    for (const Eigen::Vector3d* x : {&a, &b, &c}) holds = holds && (closest_on_triangle(*x, p, q, r).point - *x).norm() <= tolerance;
+    if (holds) return f;
+  }
+  return -1;
+}
 
 // closest(p, seed) -> the target face closest to p (seed: a face near p, or -1; only a hint).
 // area_vectors[f]: twice the area times the outward unit normal of target face f.

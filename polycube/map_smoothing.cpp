@@ -823,6 +823,7 @@ class AuditTarget {
     }
     tree_.rebuild(triangles_.begin(), triangles_.end());
     tree_.accelerate_distance_queries();
+    diagonal_ = (target.V.colwise().maxCoeff() - target.V.colwise().minCoeff()).norm();
   }
   AuditTarget(const AuditTarget&) = delete;
   AuditTarget& operator=(const AuditTarget&) = delete;
@@ -862,6 +863,17 @@ class AuditTarget {
         out[f] = 1;
         return;
       }
+      const auto corner = [this](int g, int k) -> Vec3 {
+        if (tree_index_[g] < 0) return Vec3::Constant(NAN);
+        const Point& r = triangles_[static_cast<size_t>(tree_index_[g])].vertex(k);
+        return Vec3(r.x(), r.y(), r.z());
+      };
+      const int holder = face_holding(a, b, c, closest((a + b + c) / 3, vertex_face[F(f, 0)]), vertex_face[F(f, 0)],
+                                      vertex_face[F(f, 1)], vertex_face[F(f, 2)], corner, kInFaceTolerance * diagonal_);
+      if (holder >= 0) {
+        out[f] = n.dot(area_vectors_[holder]) <= 0;
+        return;
+      }
       const auto nearest = [this](const Vec3& p, int seed) { return closest(p, seed); };
       if (image_triangle_flipped(a, b, c, vertex_face[F(f, 0)], vertex_face[F(f, 1)], vertex_face[F(f, 2)], area_vectors_, nearest)) out[f] = 1;
     });
@@ -886,6 +898,7 @@ class AuditTarget {
 
   std::vector<Vec3> area_vectors_;
   double area_ = 0;
+  double diagonal_ = 0;
   std::vector<Triangle> triangles_;
   std::vector<int> faces_;
   std::vector<int> tree_index_;  // per target face: its triangle in the tree (-1: zero area)

@@ -1,5 +1,7 @@
 #include "polycube/polycube_map.h"
 
+#include "polycube/polycube_map_data.h"
+
 #include "polycube/circle_domain.h"
 #include "polycube/contour_map.h"
 #include "polycube/disk_locator.h"
@@ -43,23 +45,6 @@ Eigen::Vector3d clamp_bary(Eigen::Vector3d w) {
   return s > 0 ? Eigen::Vector3d(w / s) : Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3);
 }
 
-// One side (model or polycube) of a piece pair.
-struct SideDisk {
-  PieceMesh piece;
-  TriMesh work;                            // the piece, its inner edges split if slits needed room
-  std::vector<int> work_face_parent;       // per work face: the piece face it lies in
-  std::vector<int> loop_contour;          // per loop: the contour (CrossSections id)
-  std::vector<Slit> slits;
-  DiskEmbedding disk;
-  std::unique_ptr<DiskLocator> locator;
-  std::vector<int> vertex_copy;            // per piece vertex: a disk vertex copying it
-  std::vector<std::vector<int>> faces_of;  // per piece face: the disk faces inside it
-};
-
-struct PiecePair {
-  SideDisk model, polycube;
-};
-
 // Splits the inner edges of a side's work mesh (slits need room), keeping the face parents.
 void refine(SideDisk& side) {
   std::vector<int> parent;
@@ -91,18 +76,6 @@ struct BoundaryWalk {
 
 }  // namespace
 
-class PolycubeMapData {
- public:
-  TriMesh model;
-  TriMesh polycube;
-  Eigen::VectorXi model_face_origin, polycube_face_origin;   // sliced face -> input face
-  std::vector<PiecePair> pairs;
-  std::vector<std::pair<int, int>> model_face_local, polycube_face_local;  // sliced face -> (pair, local face)
-  std::vector<std::vector<int>> model_sliced_faces_of, polycube_sliced_faces_of;  // input face -> sliced faces
-
-  // Maps a point of `from` (sliced face + 3D position) through its pair's disks to `to`.
-  SurfacePoint carry(bool from_polycube, int input_face, const Eigen::Vector3d& x) const;
-};
 
 namespace {
 
@@ -411,6 +384,7 @@ PolycubeMap build_polycube_map(const TriMesh& model, const PolycubeResult& resul
   auto data = std::make_shared<PolycubeMapData>();
   data->model = model;
   data->polycube = result.polycube.mesh;
+  data->polycube_sliced_vertices = ps.mesh.num_vertices();
   data->model_face_origin = ms.face_origin;
   data->polycube_face_origin = ps.face_origin;
   data->pairs.resize(n_pairs);

@@ -44,6 +44,7 @@ class TargetSurface {
   int judge(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc) const;
 
  private:
+  TriMesh target_;
   std::vector<Eigen::Vector3d> area_vectors_;
   std::vector<triangle_tree::Triangle> triangles_;
   std::vector<int> faces_;  // target face of each tree triangle
