@@ -271,6 +271,39 @@ TEST(MapCli, TheLastUntanglingLeavesNoFlippedImageTriangle) {
   EXPECT_LE(untangled.at("max_shift").get<double>(), report.at("parameters").at("untangle_shift").get<double>());
 }
 
+// The exact sampling (map_overlay.h) when the finished map misses the contract: torus_quad's map
+// sampled at P's vertices only (no refinement, smoothing or untangling) flips P's triangles; the
+// overlay of both disk triangulations is kept instead, written with as many vertices and faces in
+// polycube.obj as in polycube_on_model.obj, no flipped image triangle and P's image area equal to
+// the model's. With --no-exact the flips stay (so the overlay is what removed them).
+TEST(MapCli, ExactSamplingReplacesAFlippedSampledMap) {
+  const std::string base = "map --quiet --align none --no-refine --smooth-sweeps 0 --untangle-shift 0 " + quoted(test::data_path("torus_quad.off"));
+  const std::string without = test::temp_dir("map-exact-off");
+  const CliRun plain = polycube_cli(base + " --no-exact -o " + quoted(without));
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  EXPECT_GT(read_json(without + "/report.json").at("map").at("polycube_to_model").at("flipped").get<int>(), 0);
+
+  const std::string dir = test::temp_dir("map-exact");
+  const CliRun run = polycube_cli(base + " -o " + quoted(dir));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  const auto& map = report.at("map");
+  ASSERT_TRUE(map.at("exact").is_object());
+  EXPECT_TRUE(map.at("exact").at("kept").get<bool>());
+  for (const char* direction : {"polycube_to_model", "model_to_polycube"}) {
+    SCOPED_TRACE(direction);
+    EXPECT_EQ(map.at(direction).at("flipped").get<int>(), 0);
+    EXPECT_EQ(map.at(direction).at("degenerate").get<int>(), 0);
+    EXPECT_LT(map.at(direction).at("max_distance").get<double>(), 1e-9);
+  }
+  EXPECT_NEAR(map.at("polycube_to_model").at("area_ratio").get<double>(), 1.0, 1e-9);
+  const TriMesh P = test::load_mesh_file(dir + "/polycube.obj");
+  const TriMesh on_model = test::load_mesh_file(dir + "/polycube_on_model.obj");
+  EXPECT_EQ(P.num_vertices(), on_model.num_vertices());
+  EXPECT_EQ(P.F, on_model.F);
+  EXPECT_EQ(map.at("exact").at("triangles").get<int>(), P.num_faces());
+}
+
 // The smoothing (§3.5) is kept only when it removes flips or lowers ε_angle: CGAL's corner.off (an
 // L-shaped block, 28 triangles) has a polycube equal to itself and a map that is conformal before
 // any smoothing; relaxing it would move its images off the model's corners. A sphere's map is
