@@ -417,8 +417,17 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
         a.finished = std::move(refined);
       }
     }
+    std::unique_ptr<Finished> exact;
     if (options.exact && a.finished && !a.finished->meets_contract()) {
-      std::unique_ptr<Finished> exact = exact_map(a.model, a.polycube->polycube, *a.map, options, progress);
+      try {
+        exact = exact_map(a.model, a.polycube->polycube, *a.map, options, progress);
+      } catch (const AlgorithmError& e) {
+        // Not a result: the finished map stands.
+        progress.warning(std::string("exact sampling not made: ") + e.what());
+        a.finished->overlay = {{"error", e.what()}};
+      }
+    }
+    if (exact) {
       const bool better = exact->rank() < a.finished->rank();
       progress.stage("exact", std::string(better ? "kept" : "not kept") + " (" + std::to_string(exact->bad_p()) + " / " +
                                   std::to_string(exact->bad_m()) + " against " + std::to_string(a.finished->bad_p()) + " / " +

@@ -6,6 +6,8 @@
 #include "polycube/mesh_topology.h"
 #include "polycube/polycube_map_data.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -24,8 +26,6 @@ namespace {
 
 double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-// A corner closer to a line than this fraction of the edge it lies on counts as on the line.
-constexpr double kOnLine = 1e-14;
 
 // What made a vertex of a cell: a vertex of the P disk (kind 0, a), a vertex of the M disk
 // (kind 1, a), or the crossing of P disk edge (a, b) with M disk edge (c, d) (kind 2; a < b, c < d).
@@ -44,29 +44,75 @@ struct Corner {
   Tag tag;
 };
 
+using ExactPoint = CGAL::Exact_predicates_inexact_constructions_kernel::Point_2;
+
+int orientation(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const CGAL::Orientation o = CGAL::orientation(ExactPoint(a.x(), a.y()), ExactPoint(b.x(), b.y()), ExactPoint(c.x(), c.y()));
+  return o == CGAL::LEFT_TURN ? 1 : (o == CGAL::RIGHT_TURN ? -1 : 0);
+}
+
+// Sign of (b - a) × (c - d), exactly (a filter, then rationals).
+int cross_sign(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
+  const double x1 = b.x() - a.x(), y1 = b.y() - a.y(), x2 = c.x() - d.x(), y2 = c.y() - d.y();
+  const double value = x1 * y2 - y1 * x2;
+  const double bound = 1e-14 * (std::abs(x1 * y2) + std::abs(y1 * x2) + (std::abs(a.x()) + std::abs(b.x()) + std::abs(a.y()) + std::abs(b.y())) *
+                                                                             (std::abs(c.x()) + std::abs(d.x()) + std::abs(c.y()) + std::abs(d.y())));
+  if (std::abs(value) > bound) return value > 0 ? 1 : -1;
+  using Q = CGAL::Exact_rational;
+  const Q exact = (Q(b.x()) - Q(a.x())) * (Q(c.y()) - Q(d.y())) - (Q(b.y()) - Q(a.y())) * (Q(c.x()) - Q(d.x()));
+  return CGAL::sign(exact);
+}
+
+// The disks' vertex positions the clipping reads.
+struct Disks {
+  const Eigen::MatrixX2d& p;  // P disk uv
+  const Eigen::MatrixX2d& m;  // M disk uv
+};
+
 // Clips the convex polygon `poly` (counter-clockwise; its edge i runs from corner i to i + 1 on
-// supports[i]) by the closed half-plane left of the M disk edge from s0 to s1 (at p0, p1).
-// Corners within `tolerance` of the line count as inside, so shared edges and vertices of the two
-// disks (their common boundary) make no new corners.
-void clip(std::vector<Corner>& poly, std::vector<Support>& supports, const Eigen::Vector2d& p0, const Eigen::Vector2d& p1, int s0,
-          int s1) {
+// supports[i]) by the closed half-plane left of the edge from s0 to s1 of the M disk triangle it
+// is being clipped by. Which side each corner is on is decided exactly from what made it, never
+// from its rounded position, so that neighbouring cells agree about every point:
+//   - a vertex of T: the orientation test (the disks' shared boundary points lie exactly on
+//     the lines through them);
+//   - a vertex of the triangle: on the line if it is one of its ends, inside otherwise;
+//   - a crossing of T's edge (a, b) with the line of another edge (v, w) of the triangle, v
+//     shared with this one: it lies at t = f(v) / (f(v) − f(w)) along v → w, f the orientation
+//     against a → b, inside when t > 0 (on the line at t = 0).
+void clip(std::vector<Corner>& poly, std::vector<Support>& supports, const Disks& disks, int s0, int s1) {
   const int n = static_cast<int>(poly.size());
   if (n == 0) return;
+  const Eigen::Vector2d p0 = disks.m.row(s0), p1 = disks.m.row(s1);
   const Eigen::Vector2d direction = p1 - p0;
-  const double tolerance = kOnLine * direction.squaredNorm();
+  const Support line{1, std::min(s0, s1), std::max(s0, s1)};
   std::vector<double> side(n);
+  std::vector<int> sign(n);
   bool all_in = true;
   for (int i = 0; i < n; ++i) {
+    const Tag& tag = poly[i].tag;
     side[i] = cross2(direction, poly[i].uv - p0);
-    all_in = all_in && side[i] >= -tolerance;
+    if (tag.kind == 0) {
+      sign[i] = orientation(p0, p1, poly[i].uv);
+    } else if (tag.kind == 1) {
+      sign[i] = (tag.a == s0 || tag.a == s1) ? 0 : 1;
+    } else if (tag.c == line.u && tag.d == line.v) {
+      sign[i] = 0;
+    } else {
+      const int v = (tag.c == s0 || tag.c == s1) ? tag.c : tag.d, w = v == tag.c ? tag.d : tag.c;
+      const Eigen::Vector2d a = disks.p.row(tag.a), b = disks.p.row(tag.b), pv = disks.m.row(v), pw = disks.m.row(w);
+      const int fv = orientation(a, b, pv);
+      // sign(f(v) − f(w)) = sign((b − a) × (v − w)).
+      sign[i] = fv == 0 ? 0 : fv * cross_sign(a, b, pv, pw);
+    }
+    all_in = all_in && sign[i] >= 0;
   }
   if (all_in) return;
-  const Support line{1, std::min(s0, s1), std::max(s0, s1)};
   std::vector<Corner> out;
   std::vector<Support> out_supports;
   const auto crossing = [&](int i, int j) {
     Corner x;
-    const double t = side[i] / (side[i] - side[j]);
+    const double denominator = side[i] - side[j];
+    const double t = denominator != 0 ? std::clamp(side[i] / denominator, 0.0, 1.0) : 0.5;
     x.uv = poly[i].uv + t * (poly[j].uv - poly[i].uv);
     const Support& e = supports[i];
     if (e.side == 0) {
@@ -75,6 +121,7 @@ void clip(std::vector<Corner>& poly, std::vector<Support>& supports, const Eigen
       // Two edges of the same M disk triangle meet at their common vertex.
       const int common = (e.u == line.u || e.u == line.v) ? e.u : e.v;
       x.tag = Tag{1, common};
+      x.uv = disks.m.row(common);
     }
     return x;
   };
@@ -82,20 +129,19 @@ void clip(std::vector<Corner>& poly, std::vector<Support>& supports, const Eigen
   // the polygon leaves or enters the half-plane: no crossing is made next to it.
   for (int i = 0; i < n; ++i) {
     const int j = (i + 1) % n;
-    const bool in_i = side[i] >= -tolerance, in_j = side[j] >= -tolerance;
-    const bool on_i = std::abs(side[i]) <= tolerance, on_j = std::abs(side[j]) <= tolerance;
+    const bool in_i = sign[i] >= 0, in_j = sign[j] >= 0;
     if (in_i) {
       out.push_back(poly[i]);
       out_supports.push_back(supports[i]);
       if (!in_j) {
-        if (on_i) {
+        if (sign[i] == 0) {
           out_supports.back() = line;
         } else {
           out.push_back(crossing(i, j));
           out_supports.push_back(line);
         }
       }
-    } else if (in_j && !on_j) {
+    } else if (in_j && sign[j] != 0) {
       out.push_back(crossing(i, j));
       out_supports.push_back(supports[i]);
     }
@@ -414,6 +460,7 @@ MapOverlay overlay_map(const PolycubeMap& map) {
       return id;
     };
 
+    const Disks disks{pd.uv, md.uv};
     std::vector<Corner> poly;
     std::vector<Support> supports;
     std::vector<int> queue;
@@ -434,7 +481,7 @@ MapOverlay overlay_map(const PolycubeMap& map) {
         supports = {{0, std::min(a, b), std::max(a, b)}, {0, std::min(b, c), std::max(b, c)}, {0, std::min(c, a), std::max(c, a)}};
         for (int k = 0; k < 3 && !poly.empty(); ++k) {
           const int s0 = md.mesh.F(s, k), s1 = md.mesh.F(s, (k + 1) % 3);
-          clip(poly, supports, md.uv.row(s0), md.uv.row(s1), s0, s1);
+          clip(poly, supports, disks, s0, s1);
         }
         // Consecutive corners with the same origin are one.
         std::vector<Corner> cell;
@@ -444,10 +491,7 @@ MapOverlay overlay_map(const PolycubeMap& map) {
         if (cell.size() < 3) continue;
         double area = 0;
         for (size_t i = 0; i < cell.size(); ++i) area += cross2(cell[i].uv, cell[(i + 1) % cell.size()].uv);
-        if (!(area > 0)) {
-          ++out.skipped_cells;
-          continue;
-        }
+        if (!(area > 0)) ++out.zero_area_cells;  // kept: its neighbours share its corners
         ++out.cells;
         covered += area;
         // The neighbours across S's edges may overlap T too.

@@ -34,7 +34,8 @@ namespace polycube {
 //   on_model      per vertex: φ(v) as a point of the model (a face and barycentric coordinates)
 //   on_model_xyz  the same as positions
 //   cells         convex cells made (each triangulated by a fan)
-//   skipped_cells cells of zero area in the disk (touching triangles), not triangulated
+//   zero_area_cells  cells of zero area in the disk (a corner of one disk exactly on an edge of
+//                 the other), triangulated all the same: their neighbours share their corners
 //   collapsed     edges collapsed to remove cells too small for the audit (image or P area at
 //                 or below 1e-12 of the total): the shorter end merged into the other where the
 //                 mesh stays manifold and every moved triangle keeps its plane and orientation
@@ -47,7 +48,7 @@ struct MapOverlay {
   std::vector<SurfacePoint> on_model;
   Eigen::MatrixX3d on_model_xyz;
   long long cells = 0;
-  long long skipped_cells = 0;
+  long long zero_area_cells = 0;
   long long uncovered_faces = 0;
   int collapsed = 0;
   double seconds = 0;
