@@ -3,6 +3,8 @@
 // cover), and on chords across convex and concave polycube edges that must not count as flipped.
 #include "polycube/map_audit.h"
 
+#include "polycube/target_surface.h"
+
 #include "support/generated_meshes.h"
 
 #include <Eigen/Geometry>
@@ -430,6 +432,31 @@ TEST(MapAudit, DegenerateAndNonFiniteImagesAreCounted) {
   EXPECT_TRUE(std::isfinite(b.polycube_to_model.area_ratio));
   EXPECT_EQ(b.distortion.degenerate_image, valence);
   EXPECT_FALSE(b.ok);
+}
+
+// An image triangle lying inside one target face is judged by that face alone. Next to a sharp
+// edge the faces closest to its corners can be the neighbour: on a tetrahedron with three right
+// angles at the origin, the bottom's and the slanted face's area vectors sum to a vector at right
+// angles to the bottom, so a triangle in the bottom whose corners' faces come out as the slanted
+// one would be judged by a zero dot product (flipped) however it is oriented.
+TEST(MapAudit, ImageInsideOneFaceIsJudgedByThatFace) {
+  TriMesh tetrahedron;
+  tetrahedron.V.resize(4, 3);
+  tetrahedron.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  tetrahedron.F.resize(4, 3);
+  tetrahedron.F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;  // outward: -z, -y, -x, (1, 1, 1)
+  const TargetSurface target(tetrahedron, "test");
+  const int slanted = 3;
+  const Eigen::Vector3d a(0.1, 0.1, 0), b(0.1, 0.8, 0), c(0.8, 0.1, 0);  // in the bottom, facing -z
+  ASSERT_LT((b - a).cross(c - a).z(), 0);
+  EXPECT_EQ(target.judge(a, b, c, slanted, slanted, slanted), 0);
+  EXPECT_EQ(target.judge(a, c, b, slanted, slanted, slanted), 1);
+  // In the slanted face, corners on its edges: judged by the slanted face whichever faces the
+  // corners report.
+  const Eigen::Vector3d p(0.5, 0.5, 0), q(0, 0.5, 0.5), r(0.5, 0, 0.5);
+  ASSERT_GT((q - p).cross(r - p).dot(Eigen::Vector3d(1, 1, 1)), 0);
+  EXPECT_EQ(target.judge(p, q, r, 0, 1, 2), 0);
+  EXPECT_EQ(target.judge(p, r, q, 0, 1, 2), 1);
 }
 
 TEST(MapAudit, RejectsBadArguments) {
