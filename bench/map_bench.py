@@ -114,11 +114,18 @@ def main():
         flips = "%d / %d" % (pm.get("flipped", -1), mp.get("flipped", -1))
         if pm.get("degenerate", 0) or mp.get("degenerate", 0):
             flips += " (+ %d / %d degenerate)" % (pm.get("degenerate", 0), mp.get("degenerate", 0))
+        result = "ok" if len(r.get("alignment", {}).get("finished", [])) < 2 else "ok, %d finished" % len(r["alignment"]["finished"])
+        # The exact sampling (map_overlay.h), tried when the finished map missed the contract.
+        exact = m.get("exact") or {}
+        if "kept" in exact:
+            result += ", exact sampling %s (%.2f s)" % ("kept" if exact["kept"] else "tried", exact.get("seconds_total", 0))
+        elif "error" in exact:
+            result += ", exact sampling failed"
         rows.append("| %s | %d | %d | %s | %s | %d | %.3f | %.3f | %s | %.4f | %s | %s | %.2f | %.0f | %s | %s |" % (
             name, r["input"]["faces"], r["input"]["genus"], r["parameters"]["dz"], r["parameters"]["da"],
             r["polycube"]["corners"], m.get("eps_angle", float("nan")), m.get("eps_area", float("nan")),
             flips, pm.get("area_ratio", float("nan")), untangled, stages, s["total"], rss,
-            "ok" if len(r.get("alignment", {}).get("finished", [])) < 2 else "ok, %d finished" % len(r["alignment"]["finished"]), paper_cols))
+            result, paper_cols))
         print(rows[-1], file=sys.stderr)
     header = [
         "| mesh | triangles | genus | d_z | d_a | corners | ε_angle | ε_area | flipped P→M / M→P | image area / model area | images moved, largest shift (% of diagonal) | seconds align / topology / polycube / map / refine / smooth / untangle / retry | total s | peak RSS MB | result | paper ε_angle / ε_area / time |",
