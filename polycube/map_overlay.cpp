@@ -1,5 +1,6 @@
 #include "polycube/map_overlay.h"
 
+#include "polycube/barycentric.h"
 #include "polycube/closest_point.h"
 #include "polycube/errors.h"
 #include "polycube/image_orientation.h"
@@ -24,7 +25,6 @@ namespace polycube {
 
 namespace {
 
-double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
 
 // What made a vertex of a cell: a vertex of the P disk (kind 0, a), a vertex of the M disk
@@ -188,31 +188,6 @@ class PositionWeld {
   double tolerance_;
   std::unordered_map<std::string, std::vector<std::pair<Eigen::Vector3d, int>>> grid_;
 };
-
-// Barycentric coordinates of q in the 2D triangle (a, b, c).
-Eigen::Vector3d barycentric2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c, const Eigen::Vector2d& q) {
-  const double area = cross2(b - a, c - a);
-  if (!(std::abs(area) > 0)) return Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3);
-  const double wa = cross2(c - b, q - b) / area, wb = cross2(a - c, q - c) / area;
-  return {wa, wb, 1 - wa - wb};
-}
-
-Eigen::Vector3d clamped(Eigen::Vector3d w) {
-  w = w.cwiseMax(0.0);
-  const double s = w.sum();
-  return s > 0 ? Eigen::Vector3d(w / s) : Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3);
-}
-
-// Barycentric coordinates of x (projected onto the triangle's plane) in triangle (a, b, c).
-Eigen::Vector3d barycentric3d(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& x) {
-  const Eigen::Vector3d n = (b - a).cross(c - a);
-  const double nn = n.squaredNorm();
-  if (!(nn > 0)) return Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3);
-  const double wa = (c - b).cross(x - b).dot(n) / nn;
-  const double wb = (a - c).cross(x - c).dot(n) / nn;
-  return {wa, wb, 1 - wa - wb};
-}
-
 
 // Cells too small for the audit (image or P area at or below kTinyArea of the total): their
 // shortest edges collapsed, the removed end never one of P's own vertices, only where the mesh
@@ -428,7 +403,7 @@ MapOverlay overlay_map(const PolycubeMap& map) {
       if (tag.kind == 0) {
         x = pd.mesh.V.row(tag.a);
       } else {
-        const Eigen::Vector3d w = clamped(barycentric2(pd.uv.row(pd.mesh.F(t, 0)), pd.uv.row(pd.mesh.F(t, 1)), pd.uv.row(pd.mesh.F(t, 2)), uv));
+        const Eigen::Vector3d w = clamp_bary(barycentric2(pd.uv.row(pd.mesh.F(t, 0)), pd.uv.row(pd.mesh.F(t, 1)), pd.uv.row(pd.mesh.F(t, 2)), uv));
         x = w[0] * pd.mesh.V.row(pd.mesh.F(t, 0)).transpose() + w[1] * pd.mesh.V.row(pd.mesh.F(t, 1)).transpose() +
             w[2] * pd.mesh.V.row(pd.mesh.F(t, 2)).transpose();
       }
@@ -439,13 +414,13 @@ MapOverlay overlay_map(const PolycubeMap& map) {
       if (tag.kind == 1) {
         y = md.mesh.V.row(tag.a);
       } else {
-        const Eigen::Vector3d w = clamped(barycentric2(md.uv.row(md.mesh.F(s, 0)), md.uv.row(md.mesh.F(s, 1)), md.uv.row(md.mesh.F(s, 2)), uv));
+        const Eigen::Vector3d w = clamp_bary(barycentric2(md.uv.row(md.mesh.F(s, 0)), md.uv.row(md.mesh.F(s, 1)), md.uv.row(md.mesh.F(s, 2)), uv));
         y = w[0] * md.mesh.V.row(md.mesh.F(s, 0)).transpose() + w[1] * md.mesh.V.row(md.mesh.F(s, 1)).transpose() +
             w[2] * md.mesh.V.row(md.mesh.F(s, 2)).transpose();
       }
       SurfacePoint image;
       image.face = data.model_face_origin[MS.piece.face_to_global[MS.work_face_parent[md.face_origin[s]]]];
-      image.bary = clamped(barycentric3d(M.V.row(M.F(image.face, 0)), M.V.row(M.F(image.face, 1)), M.V.row(M.F(image.face, 2)), y));
+      image.bary = clamp_bary(barycentric3(M.V.row(M.F(image.face, 0)), M.V.row(M.F(image.face, 1)), M.V.row(M.F(image.face, 2)), y));
       if (id < 0 || id == next) {
         id = next;
         on_polycube.push_back(x);

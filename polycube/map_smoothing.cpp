@@ -1,5 +1,6 @@
 #include "polycube/map_smoothing.h"
 
+#include "polycube/barycentric.h"
 #include "polycube/closest_point.h"
 #include "polycube/image_orientation.h"
 #include "polycube/max_min_affine.h"
@@ -38,19 +39,6 @@ constexpr double kTwoPi = 2 * kPi;
 
 Vec3 row(const Eigen::MatrixX3d& X, int i) { return X.row(i).transpose(); }
 
-double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-// Barycentric coordinates of p in the 2D triangle (a, b, c) (of non-zero area).
-Vec3 barycentric2(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& p) {
-  const double area2 = cross2(b - a, c - a);
-  return Vec3(cross2(b - p, c - p), cross2(c - p, a - p), cross2(a - p, b - p)) / area2;
-}
-
-Vec3 normalized_bary(const Vec3& w) {
-  const Vec3 c = w.cwiseMax(0.0);
-  const double s = c.sum();
-  return s > 0 ? Vec3(c / s) : Vec3(1.0 / 3, 1.0 / 3, 1.0 / 3);
-}
 
 using Closest = TriangleClosest;
 
@@ -733,7 +721,7 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
             if (bary[i] < bary[lowest]) lowest = i;
           if (bary[lowest] >= -1e-12) {
             out[w].face = T;
-            out[w].bary = normalized_bary(bary);
+            out[w].bary = clamp_bary(bary);
             return true;
           }
           T = P.across()(T, lowest);
@@ -783,7 +771,7 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
             }
         if (best >= 0 && best_min >= -1e-9) {
           out[w].face = best;
-          out[w].bary = normalized_bary(best_bary);
+          out[w].bary = clamp_bary(best_bary);
           found = true;
           break;
         }

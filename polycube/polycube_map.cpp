@@ -2,6 +2,7 @@
 
 #include "polycube/polycube_map_data.h"
 
+#include "polycube/barycentric.h"
 #include "polycube/circle_domain.h"
 #include "polycube/contour_map.h"
 #include "polycube/disk_locator.h"
@@ -28,22 +29,6 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 constexpr double kTwoPi = 6.283185307179586;
-
-// Barycentric coordinates of x (projected onto the triangle's plane) in triangle (a, b, c).
-Eigen::Vector3d barycentric3(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& x) {
-  const Eigen::Vector3d n = (b - a).cross(c - a);
-  const double nn = n.squaredNorm();
-  if (!(nn > 0)) return Eigen::Vector3d(-INFINITY, -INFINITY, -INFINITY);
-  const double wa = (c - b).cross(x - b).dot(n) / nn;
-  const double wb = (a - c).cross(x - c).dot(n) / nn;
-  return {wa, wb, 1 - wa - wb};
-}
-
-Eigen::Vector3d clamp_bary(Eigen::Vector3d w) {
-  w = w.cwiseMax(0.0);
-  const double s = w.sum();
-  return s > 0 ? Eigen::Vector3d(w / s) : Eigen::Vector3d(1.0 / 3, 1.0 / 3, 1.0 / 3);
-}
 
 // Splits the inner edges of a side's work mesh (slits need room), keeping the face parents.
 void refine(SideDisk& side) {
