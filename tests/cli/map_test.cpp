@@ -277,7 +277,8 @@ TEST(MapCli, TheLastUntanglingLeavesNoFlippedImageTriangle) {
 // polycube.obj as in polycube_on_model.obj, no flipped image triangle and P's image area equal to
 // the model's. With --no-exact the flips stay (so the overlay is what removed them).
 TEST(MapCli, ExactSamplingReplacesAFlippedSampledMap) {
-  const std::string base = "map --quiet --align none --no-refine --smooth-sweeps 0 --untangle-shift 0 " + quoted(test::data_path("torus_quad.off"));
+  const std::string base = "map --quiet --align none --no-refine --smooth-sweeps 0 --untangle-shift 0 --finer-contours 1 " +
+                           quoted(test::data_path("torus_quad.off"));
   const std::string without = test::temp_dir("map-exact-off");
   const CliRun plain = polycube_cli(base + " --no-exact -o " + quoted(without));
   ASSERT_EQ(plain.code, 0) << plain.err;
