@@ -189,6 +189,14 @@ class PositionWeld {
   std::unordered_map<std::string, std::vector<std::pair<Eigen::Vector3d, int>>> grid_;
 };
 
+// The point of disk face f at disk position uv, on the surface the disk was cut from.
+Eigen::Vector3d on_surface(const DiskEmbedding& disk, int f, const Eigen::Vector2d& uv) {
+  const Eigen::Vector3d w =
+      clamp_bary(barycentric2(disk.uv.row(disk.mesh.F(f, 0)), disk.uv.row(disk.mesh.F(f, 1)), disk.uv.row(disk.mesh.F(f, 2)), uv));
+  return w[0] * disk.mesh.V.row(disk.mesh.F(f, 0)).transpose() + w[1] * disk.mesh.V.row(disk.mesh.F(f, 1)).transpose() +
+         w[2] * disk.mesh.V.row(disk.mesh.F(f, 2)).transpose();
+}
+
 // Cells too small for the audit (image or P area at or below kTinyArea of the total): their
 // shortest edges collapsed, the removed end never one of P's own vertices, only where the mesh
 // stays a manifold (link condition), every triangle moved stays in its P face's plane, keeps its
@@ -399,25 +407,11 @@ MapOverlay overlay_map(const PolycubeMap& map) {
         }
       }
       // Where the corner is on both surfaces.
-      Eigen::Vector3d x;
-      if (tag.kind == 0) {
-        x = pd.mesh.V.row(tag.a);
-      } else {
-        const Eigen::Vector3d w = clamp_bary(barycentric2(pd.uv.row(pd.mesh.F(t, 0)), pd.uv.row(pd.mesh.F(t, 1)), pd.uv.row(pd.mesh.F(t, 2)), uv));
-        x = w[0] * pd.mesh.V.row(pd.mesh.F(t, 0)).transpose() + w[1] * pd.mesh.V.row(pd.mesh.F(t, 1)).transpose() +
-            w[2] * pd.mesh.V.row(pd.mesh.F(t, 2)).transpose();
-      }
+      const Eigen::Vector3d x = tag.kind == 0 ? Eigen::Vector3d(pd.mesh.V.row(tag.a)) : on_surface(pd, t, uv);
       const int next = static_cast<int>(on_polycube.size());
       if (boundary) id = weld.find_or_add(x, next);
       if (id >= 0 && id < next && seen[id]) return id;
-      Eigen::Vector3d y;
-      if (tag.kind == 1) {
-        y = md.mesh.V.row(tag.a);
-      } else {
-        const Eigen::Vector3d w = clamp_bary(barycentric2(md.uv.row(md.mesh.F(s, 0)), md.uv.row(md.mesh.F(s, 1)), md.uv.row(md.mesh.F(s, 2)), uv));
-        y = w[0] * md.mesh.V.row(md.mesh.F(s, 0)).transpose() + w[1] * md.mesh.V.row(md.mesh.F(s, 1)).transpose() +
-            w[2] * md.mesh.V.row(md.mesh.F(s, 2)).transpose();
-      }
+      const Eigen::Vector3d y = tag.kind == 1 ? Eigen::Vector3d(md.mesh.V.row(tag.a)) : on_surface(md, s, uv);
       SurfacePoint image;
       image.face = data.model_face_origin[MS.piece.face_to_global[MS.work_face_parent[md.face_origin[s]]]];
       image.bary = clamp_bary(barycentric3(M.V.row(M.F(image.face, 0)), M.V.row(M.F(image.face, 1)), M.V.row(M.F(image.face, 2)), y));
