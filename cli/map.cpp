@@ -52,8 +52,9 @@ struct MapOptions {
   // When no finished map of the orientation search meets the contract, the search and its maps
   // run once more with d_a divided by this (finer contours); 1: never.
   double finer_contours = 3;
-  // When a finished map misses the contract, also the exact sampling of the unsmoothed map
-  // (map_overlay.h), kept if it ranks better.
+  // When no finished map (every orientation, finer contours included) meets the contract, the
+  // exact sampling of their unsmoothed maps (map_overlay.h), best-ranked first, kept where it
+  // ranks better.
   bool exact = true;
   TopologyOptions topology;
   PolycubeOptions polycube;
@@ -743,8 +744,9 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
       ->check(CLI::Range(1.0, 100.0))
       ->capture_default_str();
   command->add_flag("--no-exact{false}", options->exact,
-                   "When the finished map still has flipped triangles or misses area, do not try the exact sampling (P triangulated "
-                   "by both disk triangulations of every piece, where the unsmoothed map is affine on each triangle)");
+                   "When no finished map is free of flipped triangles with the area within 2 %, do not try the exact sampling "
+                   "last (P triangulated by both disk triangulations of every piece, where the unsmoothed map is affine on each "
+                   "triangle)");
   command->add_option("--stage", options->stage, "Stop after this stage")
       ->capture_default_str()
       ->check(CLI::IsMember(kStages));
