@@ -15,7 +15,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <string>
 #include <unordered_map>
@@ -24,8 +23,6 @@
 namespace polycube {
 
 namespace {
-
-
 
 // What made a vertex of a cell: a vertex of the P disk (kind 0, a), a vertex of the M disk
 // (kind 1, a), or the crossing of P disk edge (a, b) with M disk edge (c, d) (kind 2; a < b, c < d).
@@ -168,12 +165,12 @@ class PositionWeld {
     for (long long dx = -1; dx <= 1; ++dx)
       for (long long dy = -1; dy <= 1; ++dy)
         for (long long dz = -1; dz <= 1; ++dz) {
-          const auto it = grid_.find(key({cell[0] + dx, cell[1] + dy, cell[2] + dz}));
+          const auto it = grid_.find({cell[0] + dx, cell[1] + dy, cell[2] + dz});
           if (it == grid_.end()) continue;
           for (const auto& [p, id] : it->second)
             if ((p - x).norm() <= tolerance_) return id;
         }
-    grid_[key(cell)].emplace_back(x, fresh);
+    grid_[cell].emplace_back(x, fresh);
     return fresh;
   }
 
@@ -182,11 +179,8 @@ class PositionWeld {
     return {static_cast<long long>(std::floor(x.x() / tolerance_)), static_cast<long long>(std::floor(x.y() / tolerance_)),
             static_cast<long long>(std::floor(x.z() / tolerance_))};
   }
-  static std::string key(const std::array<long long, 3>& c) {
-    return std::to_string(c[0]) + "," + std::to_string(c[1]) + "," + std::to_string(c[2]);
-  }
   double tolerance_;
-  std::unordered_map<std::string, std::vector<std::pair<Eigen::Vector3d, int>>> grid_;
+  std::map<std::array<long long, 3>, std::vector<std::pair<Eigen::Vector3d, int>>> grid_;
 };
 
 // The point of disk face f at disk position uv, on the surface the disk was cut from.
