@@ -53,10 +53,12 @@ int face_holding(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
 
 // closest(p, seed) -> the target face closest to p (seed: a face near p, or -1; only a hint).
 // area_vectors[f]: twice the area times the outward unit normal of target face f.
-// fa, fb, fc: the faces closest to a, b, c.
-template <class ClosestFace>
+// fa, fb, fc: the faces closest to a, b, c. corners(f, k): corner k of target face f; in_face:
+// kInFaceTolerance × the target's bounding-box diagonal (face_holding).
+template <class ClosestFace, class Corners>
 bool image_triangle_flipped(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc,
-                            const std::vector<Eigen::Vector3d>& area_vectors, const ClosestFace& closest) {
+                            const std::vector<Eigen::Vector3d>& area_vectors, const ClosestFace& closest, const Corners& corners,
+                            double in_face) {
   const Eigen::Vector3d n = (b - a).cross(c - a);
   constexpr int kOrder = 4;
   // The centroid, the corners, then the grid's points off the corners: at most 4 + 12 faces
@@ -67,6 +69,9 @@ bool image_triangle_flipped(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   faces[count++] = fa;
   faces[count++] = fb;
   faces[count++] = fc;
+  // Inside one of those faces: that face alone decides.
+  const int holder = face_holding(a, b, c, faces[0], fa, fb, fc, corners, in_face);
+  if (holder >= 0) return n.dot(area_vectors[holder]) <= 0;
   auto faces_away = [&]() {
     std::sort(faces.begin(), faces.begin() + count);
     count = static_cast<int>(std::unique(faces.begin(), faces.begin() + count) - faces.begin());

@@ -193,31 +193,36 @@ Eigen::Vector3d on_surface(const DiskEmbedding& disk, int f, const Eigen::Vector
 
 // Cells too small for the audit (image or P area at or below kTinyArea of the total): their
 // shortest edges collapsed, the removed end never one of P's own vertices, only where the mesh
-// stays a manifold (link condition), every triangle moved stays in its P face's plane, keeps its
-// orientation on P and on the model, and does not become tiny itself. Returns collapses made.
+// stays a manifold (link condition) and every triangle moved stays in its P face's plane and in
+// its model face (to a tenth of the audit's in-face tolerance), keeps its orientation on both,
+// and is not tiny afterwards unless it was and got no smaller (a cluster of tiny cells merges
+// step by step). Passes repeat while collapses are made, at most 20. Returns collapses made.
 constexpr double kTinyArea = 1e-12;
 
 int collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMesh& M) {
   TriMesh& R = out.polycube;
   const Eigen::MatrixX3d& image = out.on_model_xyz;
   const int nv = R.num_vertices();
-  double p_area = 0, m_area = 0;
-  for (int f = 0; f < P.num_faces(); ++f)
-    p_area += 0.5 * (P.V.row(P.F(f, 1)) - P.V.row(P.F(f, 0))).cross(P.V.row(P.F(f, 2)) - P.V.row(P.F(f, 0))).norm();
-  for (int f = 0; f < M.num_faces(); ++f)
-    m_area += 0.5 * (M.V.row(M.F(f, 1)) - M.V.row(M.F(f, 0))).cross(M.V.row(M.F(f, 2)) - M.V.row(M.F(f, 0))).norm();
-  const double tiny_p = kTinyArea * p_area, tiny_m = kTinyArea * m_area;
-  const double plane_tolerance = 1e-12 * (P.V.colwise().maxCoeff() - P.V.colwise().minCoeff()).norm();
-  const double in_face = 0.1 * kInFaceTolerance * (M.V.colwise().maxCoeff() - M.V.colwise().minCoeff()).norm();
-  std::vector<Eigen::Vector3d> p_normal(P.num_faces()), m_normal(M.num_faces());
-  for (int f = 0; f < P.num_faces(); ++f)
-    p_normal[f] = (P.V.row(P.F(f, 1)) - P.V.row(P.F(f, 0))).cross(P.V.row(P.F(f, 2)) - P.V.row(P.F(f, 0))).normalized();
-  for (int f = 0; f < M.num_faces(); ++f)
-    m_normal[f] = (M.V.row(M.F(f, 1)) - M.V.row(M.F(f, 0))).cross(M.V.row(M.F(f, 2)) - M.V.row(M.F(f, 0))).normalized();
   const auto area_vector = [](const auto& X, int a, int b, int c) -> Eigen::Vector3d {
     const Eigen::Vector3d x = X.row(a), y = X.row(b), z = X.row(c);
     return 0.5 * (y - x).cross(z - x);
   };
+  // Unit normals of P's and M's faces, and their total areas.
+  const auto normals = [&](const TriMesh& mesh, double& area) {
+    std::vector<Eigen::Vector3d> unit(mesh.num_faces());
+    area = 0;
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const Eigen::Vector3d v = area_vector(mesh.V, mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2));
+      area += v.norm();
+      unit[f] = v.normalized();
+    }
+    return unit;
+  };
+  double p_area = 0, m_area = 0;
+  const std::vector<Eigen::Vector3d> p_normal = normals(P, p_area), m_normal = normals(M, m_area);
+  const double tiny_p = kTinyArea * p_area, tiny_m = kTinyArea * m_area;
+  const double plane_tolerance = 1e-12 * (P.V.colwise().maxCoeff() - P.V.colwise().minCoeff()).norm();
+  const double in_face = 0.1 * kInFaceTolerance * (M.V.colwise().maxCoeff() - M.V.colwise().minCoeff()).norm();
   const auto tiny = [&](int f) {
     return area_vector(R.V, R.F(f, 0), R.F(f, 1), R.F(f, 2)).norm() <= tiny_p ||
            area_vector(image, R.F(f, 0), R.F(f, 1), R.F(f, 2)).norm() <= tiny_m;
@@ -254,7 +259,6 @@ int collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMes
       const int parent = out.face_parent[f];
       if (std::abs((R.V.row(k) - P.V.row(P.F(parent, 0))).dot(p_normal[parent])) > plane_tolerance) return false;
       const Eigen::Vector3d on_p = area_vector(R.V, c[0], c[1], c[2]), on_m = area_vector(image, c[0], c[1], c[2]);
-      // Not tiny, or no smaller than before (a cluster of tiny cells merges step by step).
       const Eigen::Vector3d old_p = area_vector(R.V, R.F(f, 0), R.F(f, 1), R.F(f, 2)), old_m = area_vector(image, R.F(f, 0), R.F(f, 1), R.F(f, 2));
       if (!(on_p.dot(p_normal[parent]) > std::min(tiny_p, old_p.norm()))) return false;
       if (!(on_m.norm() > std::min(tiny_m, old_m.norm()))) return false;

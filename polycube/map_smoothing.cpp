@@ -856,14 +856,10 @@ class AuditTarget {
         const Point& r = triangles_[static_cast<size_t>(tree_index_[g])].vertex(k);
         return Vec3(r.x(), r.y(), r.z());
       };
-      const int holder = face_holding(a, b, c, closest((a + b + c) / 3, vertex_face[F(f, 0)]), vertex_face[F(f, 0)],
-                                      vertex_face[F(f, 1)], vertex_face[F(f, 2)], corner, kInFaceTolerance * diagonal_);
-      if (holder >= 0) {
-        out[f] = n.dot(area_vectors_[holder]) <= 0;
-        return;
-      }
       const auto nearest = [this](const Vec3& p, int seed) { return closest(p, seed); };
-      if (image_triangle_flipped(a, b, c, vertex_face[F(f, 0)], vertex_face[F(f, 1)], vertex_face[F(f, 2)], area_vectors_, nearest)) out[f] = 1;
+      if (image_triangle_flipped(a, b, c, vertex_face[F(f, 0)], vertex_face[F(f, 1)], vertex_face[F(f, 2)], area_vectors_, nearest, corner,
+                                 kInFaceTolerance * diagonal_))
+        out[f] = 1;
     });
     return out;
   }

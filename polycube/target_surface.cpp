@@ -31,10 +31,8 @@ TargetSurface::TargetSurface(const TriMesh& target, const char* what) : target_(
 int TargetSurface::judge(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc) const {
   if (0.5 * (b - a).cross(c - a).norm() <= kAuditDegenerateArea * area_) return 2;
   const auto corner = [this](int f, int k) -> Eigen::Vector3d { return target_.V.row(target_.F(f, k)); };
-  const int holder = face_holding(a, b, c, closest((a + b + c) / 3).first, fa, fb, fc, corner, kInFaceTolerance * diagonal_);
-  if (holder >= 0) return (b - a).cross(c - a).dot(area_vectors_[holder]) <= 0 ? 1 : 0;
   const auto nearest = [this](const Eigen::Vector3d& p, int) { return closest(p).first; };
-  return image_triangle_flipped(a, b, c, fa, fb, fc, area_vectors_, nearest) ? 1 : 0;
+  return image_triangle_flipped(a, b, c, fa, fb, fc, area_vectors_, nearest, corner, kInFaceTolerance * diagonal_) ? 1 : 0;
 }
 
 std::pair<int, double> TargetSurface::closest(const Eigen::Vector3d& p) const {
