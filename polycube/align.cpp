@@ -35,7 +35,7 @@ Eigen::Matrix3d snapped_to_coordinate_axes(const Eigen::Matrix3d& axes) {
 
 }  // namespace
 
-Eigen::Matrix3d principal_axes(const TriMesh& mesh) {
+Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread) {
   // Second moments of the surface, each triangle integrated exactly (vertices and centroid rule).
   double area_sum = 0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -49,10 +49,12 @@ Eigen::Matrix3d principal_axes(const TriMesh& mesh) {
     const Eigen::Vector3d s = a + b + c;
     second += area / 12 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
   }
+  if (spread) *spread = 1;
   if (!(area_sum > 0)) return Eigen::Matrix3d::Identity();
   mean /= area_sum;
   const Eigen::Matrix3d covariance = second / area_sum - mean * mean.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  if (spread && solver.eigenvalues()(0) > 0) *spread = solver.eigenvalues()(2) / solver.eigenvalues()(0);
   Eigen::Matrix3d axes;
   for (int i = 0; i < 3; ++i) axes.row(i) = solver.eigenvectors().col(2 - i).transpose();  // largest first
   if (axes.determinant() < 0) axes.row(2) *= -1;
@@ -173,7 +175,9 @@ std::vector<AlignedStages> Alignment::stages_in_order() const {
 Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology, const PolycubeOptions& polycube,
                            const AlignmentOptions& options) {
   Alignment out;
-  const Eigen::Matrix3d pca = principal_axes(mesh);
+  double spread = 1;
+  const Eigen::Matrix3d pca = principal_axes(mesh, &spread);
+  const bool reserve_principal = !(spread >= options.principal_axes_spread);
   // A large model is scored on a coarser copy (same topology); the winner's stages are then built
   // on the model itself.
   TriMesh proxy;
@@ -208,7 +212,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     }
   };
   add_frame(0);
-  add_frame(1);
+  if (!reserve_principal) add_frame(1);
   if (distinct_normals && !reserve_normals) add_frame(2);
   PolycubeOptions scoring = polycube;
   scoring.max_rounds = std::min(scoring.max_rounds, options.max_rounds);
@@ -270,9 +274,12 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   };
   score(0);
   auto any_passed = [&]() { return std::any_of(polycubes.begin(), polycubes.end(), [](const auto& p) { return p != nullptr; }); };
-  if (!any_passed() && reserve_normals) {
+  // Frames held in reserve (the normals' when the faces do not align with it, the principal axes
+  // when the variances hardly differ), when no candidate passed.
+  for (const int frame : {1, 2}) {
+    if (any_passed() || !(frame == 1 ? reserve_principal : reserve_normals)) continue;
     const int first = static_cast<int>(out.candidates.size());
-    add_frame(2);
+    add_frame(frame);
     score(first);
   }
   int n = static_cast<int>(out.candidates.size());

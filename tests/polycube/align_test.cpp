@@ -86,6 +86,27 @@ TEST(Align, TurnedCadPartGetsItsFrameBack) {
   EXPECT_LT((a.candidates[6].rotation - found).norm(), 1e-12);
 }
 
+// A cube's principal axes are any axes (its variances are equal; rounding picks them), so they
+// are no candidate while another passes; a box's are (its spread is 16: 4² / 1²).
+TEST(Align, PrincipalAxesOfACubeAreHeldInReserve) {
+  TriMesh cube = box(Eigen::Vector3d(1, 2, 3));
+  cube.V.col(0) /= 2;
+  cube.V.col(2) *= 2;
+  double spread = 0;
+  principal_axes(cube, &spread);
+  EXPECT_NEAR(spread, 1.0, 1e-9);
+  principal_axes(box(Eigen::Vector3d::Zero()), &spread);
+  EXPECT_GT(spread, AlignmentOptions{}.principal_axes_spread);
+  AlignmentOptions options;
+  options.mapped_candidates = 0;
+  const Alignment a = choose_alignment(cube, TopologyOptions{}, PolycubeOptions{}, options);
+  ASSERT_EQ(a.candidates.size(), 3u);
+  for (const AlignmentCandidate& c : a.candidates) EXPECT_EQ(c.name.rfind("input frame", 0), 0u) << c.name;
+  EXPECT_GE(a.chosen, 0);
+  options.principal_axes_spread = 1;
+  EXPECT_EQ(choose_alignment(cube, TopologyOptions{}, PolycubeOptions{}, options).candidates.size(), 6u);
+}
+
 // Nothing passes a scoring budget of one round and no inserted plane (rotor needs several rounds
 // and planes in its input frame): the candidates are built again with four times that budget, the
 // one with the fewest corners wins (or, when none passes that either, the first that builds with
