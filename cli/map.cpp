@@ -349,7 +349,7 @@ std::unique_ptr<Finished> exact_map(const TriMesh& model, const Polycube& P, con
   out->on_polycube_xyz = map.model_on_polycube_xyz;
   out->audit = audit_map(model, R.mesh, out->on_model_xyz, out->on_polycube_xyz);
   out->overlay = {{"triangles", R.mesh.num_faces()}, {"vertices", R.mesh.num_vertices()}, {"cells", overlay.cells},
-                  {"collapsed", overlay.collapsed}, {"seconds", overlay.seconds}};
+                  {"collapsed", overlay.collapsed}, {"flipped_edges", overlay.flipped_edges}, {"seconds", overlay.seconds}};
   progress.stage("exact", std::to_string(R.mesh.num_faces()) + " triangles; " + std::to_string(out->bad_p()) + " / " +
                               std::to_string(out->bad_m()) + " flipped or degenerate (P to M / M to P), image area " +
                               std::to_string(out->audit.polycube_to_model.area_ratio));

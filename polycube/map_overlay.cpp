@@ -4,6 +4,7 @@
 #include "polycube/closest_point.h"
 #include "polycube/errors.h"
 #include "polycube/image_orientation.h"
+#include "polycube/map_audit.h"
 #include "polycube/mesh_topology.h"
 #include "polycube/polycube_map_data.h"
 
@@ -194,12 +195,19 @@ Eigen::Vector3d on_surface(const DiskEmbedding& disk, int f, const Eigen::Vector
 // Cells too small for the audit (image or P area at or below kTinyArea of the total): their
 // shortest edges collapsed, the removed end never one of P's own vertices, only where the mesh
 // stays a manifold (link condition) and every triangle moved stays in its P face's plane and in
-// its model face (to a tenth of the audit's in-face tolerance), keeps its orientation on both,
-// and is not tiny afterwards unless it was and got no smaller (a cluster of tiny cells merges
-// step by step). Passes repeat while collapses are made, at most 20. Returns collapses made.
+// its model face (to a tenth of the audit's in-face tolerance); a moved triangle the audit passes
+// must keep its orientation on both and not become tiny, a tiny one must not turn over by more
+// than the audit's degenerate area (a cluster of tiny cells where an edge of P, an edge of the
+// model and a cutting plane meet merges step by step: cheese had 10 image triangles below the
+// audit's area when tiny ones had to shrink too). Passes repeat while collapses are made, at
+// most 20. Then the tiny cells left get their longest edge flipped where both faces lie in one
+// face of P and one of the model and both new triangles are positive and not tiny on both (the
+// two tile the same quadrilateral of P and of the model, so the tiling and areas are kept; the
+// map is then affine on the pair's union instead of each). Counts in out.collapsed and
+// out.flipped_edges.
 constexpr double kTinyArea = 1e-12;
 
-int collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMesh& M) {
+void collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMesh& M) {
   TriMesh& R = out.polycube;
   const Eigen::MatrixX3d& image = out.on_model_xyz;
   const int nv = R.num_vertices();
@@ -221,6 +229,7 @@ int collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMes
   double p_area = 0, m_area = 0;
   const std::vector<Eigen::Vector3d> p_normal = normals(P, p_area), m_normal = normals(M, m_area);
   const double tiny_p = kTinyArea * p_area, tiny_m = kTinyArea * m_area;
+  const double degenerate_p = kAuditDegenerateArea * p_area, degenerate_m = kAuditDegenerateArea * m_area;
   const double plane_tolerance = 1e-12 * (P.V.colwise().maxCoeff() - P.V.colwise().minCoeff()).norm();
   const double in_face = 0.1 * kInFaceTolerance * (M.V.colwise().maxCoeff() - M.V.colwise().minCoeff()).norm();
   const auto tiny = [&](int f) {
@@ -260,9 +269,16 @@ int collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMes
       if (std::abs((R.V.row(k) - P.V.row(P.F(parent, 0))).dot(p_normal[parent])) > plane_tolerance) return false;
       const Eigen::Vector3d on_p = area_vector(R.V, c[0], c[1], c[2]), on_m = area_vector(image, c[0], c[1], c[2]);
       const Eigen::Vector3d old_p = area_vector(R.V, R.F(f, 0), R.F(f, 1), R.F(f, 2)), old_m = area_vector(image, R.F(f, 0), R.F(f, 1), R.F(f, 2));
-      if (!(on_p.dot(p_normal[parent]) > std::min(tiny_p, old_p.norm()))) return false;
-      if (!(on_m.norm() > std::min(tiny_m, old_m.norm()))) return false;
-      if (!(on_m.dot(m_normal[out.face_image[f]]) > 0)) return false;
+      if (old_p.norm() > tiny_p && old_m.norm() > tiny_m) {
+        // A triangle the audit passes stays so.
+        if (!(on_p.dot(p_normal[parent]) > tiny_p)) return false;
+        if (!(on_m.norm() > tiny_m)) return false;
+        if (!(on_m.dot(m_normal[out.face_image[f]]) > 0)) return false;
+      } else {
+        // A tiny one (to be removed in turn) may stay tiny, but not turn over by more than the
+        // audit's degenerate area (it would count as flipped).
+        if (!(on_p.dot(p_normal[parent]) > -degenerate_p) || !(on_m.dot(m_normal[out.face_image[f]]) > -degenerate_m)) return false;
+      }
       // And it stays in its model face (the audit then judges it by that face alone).
       const int mf = out.face_image[f];
       const Eigen::Vector3d y = image.row(k);
@@ -304,7 +320,56 @@ int collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMes
     collapses += made;
     if (made == 0) break;
   }
-  if (collapses == 0) return 0;
+  // The tiny cells left: edge flips.
+  int flips = 0;
+  for (int pass = 0; pass < 20; ++pass) {
+    int made = 0;
+    for (int f = 0; f < R.num_faces(); ++f) {
+      if (dead[f] || !tiny(f)) continue;
+      std::array<std::pair<double, int>, 3> edges;
+      for (int i = 0; i < 3; ++i) {
+        const int a = R.F(f, i), b = R.F(f, (i + 1) % 3);
+        edges[i] = {-((R.V.row(a) - R.V.row(b)).norm() + (image.row(a) - image.row(b)).norm()), i};
+      }
+      std::sort(edges.begin(), edges.end());
+      for (const auto& [length, i] : edges) {
+        const int a = R.F(f, i), b = R.F(f, (i + 1) % 3), c = R.F(f, (i + 2) % 3);
+        int g = -1, d = -1;
+        for (int h : around[a]) {
+          if (dead[h] || h == f) continue;
+          for (int k = 0; k < 3; ++k)
+            if (R.F(h, k) == b && R.F(h, (k + 1) % 3) == a) {
+              g = h;
+              d = R.F(h, (k + 2) % 3);
+            }
+        }
+        if (g < 0 || out.face_parent[g] != out.face_parent[f] || out.face_image[g] != out.face_image[f]) continue;
+        neighbours(c, neighbours_r);
+        if (std::binary_search(neighbours_r.begin(), neighbours_r.end(), d)) continue;  // edge c-d exists
+        const int parent = out.face_parent[f], mf = out.face_image[f];
+        bool ok = true;
+        for (const auto& t : {std::array<int, 3>{c, a, d}, std::array<int, 3>{d, b, c}}) {
+          const Eigen::Vector3d on_p = area_vector(R.V, t[0], t[1], t[2]), on_m = area_vector(image, t[0], t[1], t[2]);
+          ok = ok && on_p.dot(p_normal[parent]) > tiny_p && on_m.dot(m_normal[mf]) > tiny_m;
+        }
+        if (!ok) continue;
+        R.F.row(f) << c, a, d;
+        R.F.row(g) << d, b, c;
+        // f left b and gained d, g left a and gained c.
+        around[b].erase(std::find(around[b].begin(), around[b].end(), f));
+        around[a].erase(std::find(around[a].begin(), around[a].end(), g));
+        around[d].push_back(f);
+        around[c].push_back(g);
+        ++made;
+        break;
+      }
+    }
+    flips += made;
+    if (made == 0) break;
+  }
+  out.collapsed = collapses;
+  out.flipped_edges = flips;
+  if (collapses + flips == 0) return;
   // Compaction: live faces, used vertices (P's own keep their ids: never removed).
   std::vector<int> new_id(nv, -1);
   int next = 0;
@@ -336,7 +401,6 @@ int collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMes
   out.on_model = std::move(compact_on_model);
   out.face_parent = std::move(parent);
   out.face_image = std::move(image_face);
-  return collapses;
 }
 
 }  // namespace
@@ -514,7 +578,7 @@ MapOverlay overlay_map(const PolycubeMap& map) {
   for (size_t f = 0; f < faces.size(); ++f) out.polycube.F.row(static_cast<int>(f)) = faces[f];
   out.face_parent = Eigen::Map<const Eigen::VectorXi>(face_parent.data(), static_cast<int>(face_parent.size()));
   out.face_image = Eigen::Map<const Eigen::VectorXi>(face_image.data(), static_cast<int>(face_image.size()));
-  out.collapsed = collapse_tiny_cells(out, own, P, M);
+  collapse_tiny_cells(out, own, P, M);
   const EdgeMap edges = build_edge_map(out.polycube.F);
   int open = 0;
   for (int e = 0; e < edges.num_edges(); ++e) open += edges.face_count[e] != 2;

@@ -39,6 +39,8 @@ namespace polycube {
 //   collapsed     edges collapsed to remove cells too small for the audit (image or P area at
 //                 or below 1e-12 of the total): the shorter end merged into the other where the
 //                 mesh stays manifold and every moved triangle keeps its plane and orientation
+//   flipped_edges edges flipped to remove the tiny cells no collapse could: both faces in one face
+//                 of P and one of the model, both new triangles positive and not tiny on both
 //   uncovered_faces  P disk triangles whose cells do not sum to their area (to 1e-9): 0 unless
 //                 the walk over M's disk triangles missed some (a defect; the tests assert 0)
 struct MapOverlay {
@@ -51,6 +53,7 @@ struct MapOverlay {
   long long zero_area_cells = 0;
   long long uncovered_faces = 0;
   int collapsed = 0;
+  int flipped_edges = 0;
   double seconds = 0;
 };
 
