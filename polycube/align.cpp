@@ -274,12 +274,10 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   };
   score(0);
   auto any_passed = [&]() { return std::any_of(polycubes.begin(), polycubes.end(), [](const auto& p) { return p != nullptr; }); };
-  // Frames held in reserve (the normals' when the faces do not align with it, the principal axes
-  // when the variances hardly differ), when no candidate passed.
-  for (const int frame : {1, 2}) {
-    if (any_passed() || !(frame == 1 ? reserve_principal : reserve_normals)) continue;
+  // The normals' frame in reserve (the faces do not align with it), when no candidate passed.
+  if (!any_passed() && reserve_normals) {
     const int first = static_cast<int>(out.candidates.size());
-    add_frame(frame);
+    add_frame(2);
     score(first);
   }
   int n = static_cast<int>(out.candidates.size());
@@ -393,6 +391,23 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     std::vector<int> all(n);
     std::iota(all.begin(), all.end(), 0);
     parallel_for_each(all, options.threads, "orientation", [&](int i) { build_fallback(i, larger); });
+    if (!any_passed() && reserve_principal) {
+      // The principal axes in reserve (the variances hardly differ), only now: they are any axes,
+      // and a turned box is slow to fail (cheese: 481, 701 and 306 s under the scoring budget,
+      // where its own frame passed four times that budget in 11 s).
+      const int first = n;
+      add_frame(1);
+      n = static_cast<int>(out.candidates.size());
+      topologies.resize(n);
+      polycubes.resize(n);
+      turned.resize(n);
+      maps.resize(n);
+      std::vector<int> added(n - first);
+      std::iota(added.begin(), added.end(), first);
+      parallel_for_each(added, options.threads, "orientation", [&](int i) { build_fallback(i, larger); });
+      all.resize(n);
+      std::iota(all.begin(), all.end(), 0);
+    }
     for (int i = 0; i < n; ++i)
       if (polycubes[i] && (out.chosen < 0 || out.candidates[i].corners < out.candidates[out.chosen].corners)) out.chosen = i;
     for (int i = 0; i < n && out.chosen < 0; ++i) {

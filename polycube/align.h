@@ -1,6 +1,6 @@
 // Auto-orientation (the paper's limitation 1: its polycube depends on how the model is turned).
 // Candidates are the input frame, the model's principal axes (when its variances differ; otherwise
-// only when no other candidate passes the scoring budget) and the frame its surface normals
+// only when no other candidate passes four times the scoring budget) and the frame its surface normals
 // align with best (normal_axes; when they align markedly, as a CAD part's do; otherwise only when
 // no other candidate passes the scoring budget; never when it is one of the other two), each with
 // each of its
@@ -118,7 +118,8 @@ struct AlignmentOptions {
   // factor (principal_axes' spread); below it they are noise (a cube turned by rounding: cheese,
   // genus 133, spread 1.19, had 116 459 corners there against 2 516 in its own frame; its three
   // principal candidates took 625, 892 and 387 s, the alignment 1 028 s of a 1 730 s run), and
-  // are tried only when no other candidate passes the scoring budget.
+  // are tried only when no other candidate passes four times the scoring budget (cheese's own
+  // frame passes only that).
   double principal_axes_spread = 1.25;
   // Models with more faces than proxy_above are scored on a copy simplified to about proxy_faces
   // faces (simplify.h); the winner's topology and polycube are then built on the model itself
