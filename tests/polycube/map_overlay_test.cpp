@@ -3,6 +3,7 @@
 // and oriented with it) on which the sampled map is φ: every image triangle lies in one model
 // face (up to the cells collapsed for being too small) with that face's orientation, and the
 // images tile the model (total area equal).
+#include "polycube/map_audit.h"
 #include "polycube/map_overlay.h"
 
 #include "polycube/mesh_topology.h"
@@ -57,7 +58,7 @@ TEST_P(MapOverlayOnMeshes, TilesBothSurfacesWithOrientedCells) {
   // Collapsing a cell too small for the audit moves its triangles' corners by at most the edge
   // collapsed (far below 1e-6 of the diagonal): those triangles are chords that close to their face.
   const double diagonal = (m.model.V.colwise().maxCoeff() - m.model.V.colwise().minCoeff()).norm();
-  int off_parent = 0, reversed_on_p = 0, off_image_face = 0, reversed_on_m = 0;
+  int off_parent = 0, reversed_on_p = 0, off_image_face = 0, reversed_on_m = 0, degenerate = 0;
   for (int f = 0; f < R.num_faces(); ++f) {
     // On P: inside the plane of its parent face, facing the same way (cells of zero area aside).
     const int parent = overlay.face_parent[f];
@@ -71,12 +72,15 @@ TEST_P(MapOverlayOnMeshes, TilesBothSurfacesWithOrientedCells) {
     const Eigen::Vector3d ni = face_normal(image, f);
     for (int k = 0; k < 3; ++k)
       off_image_face += std::abs((image.V.row(image.F(f, k)) - m.model.V.row(m.model.F(mf, 0))).dot(nm)) > 1e-6 * diagonal;
+    // No cell left below the audit's degenerate area on either surface (collapsed or flipped).
+    degenerate += nr.norm() / 2 <= kAuditDegenerateArea * p_area || ni.norm() / 2 <= kAuditDegenerateArea * m_area;
     if (ni.norm() > 1e-14 * m_area && ni.dot(nm) <= 0) { ++reversed_on_m; ADD_FAILURE() << "reversed image " << f << ": image area " << ni.norm() / 2 << " of " << m_area << ", on P " << nr.norm() / 2; }
   }
   EXPECT_EQ(off_parent, 0) << name;
   EXPECT_EQ(reversed_on_p, 0) << name;
   EXPECT_EQ(off_image_face, 0) << name;
   EXPECT_EQ(reversed_on_m, 0) << name;
+  EXPECT_EQ(degenerate, 0) << name;
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, MapOverlayOnMeshes,
