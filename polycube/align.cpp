@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <chrono>
 #include <tuple>
 #include <numeric>
@@ -252,15 +253,18 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   // Topology and polycube, under the scoring budget, of candidates [first, end).
-  auto score = [&](int first) {
+  // Runs `step` on the candidates [first, end) (those just added), in parallel; returns end.
+  auto run_added = [&](int first, const std::function<void(int)>& step) {
     const int end = static_cast<int>(out.candidates.size());
     topologies.resize(end);
     polycubes.resize(end);
     turned.resize(end);
     std::vector<int> order(end - first);
     std::iota(order.begin(), order.end(), first);
-    parallel_for_each(order, options.threads, "orientation", [&](int i) { build(i, scoring); });
+    parallel_for_each(order, options.threads, "orientation", step);
+    return end;
   };
+  auto score = [&](int first) { run_added(first, [&](int i) { build(i, scoring); }); };
   // Four times the scoring budget (capped by the caller's), for candidates given a second chance.
   PolycubeOptions larger = polycube;
   larger.max_rounds = std::min(polycube.max_rounds, 4 * scoring.max_rounds);
@@ -397,14 +401,8 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       // where its own frame passed four times that budget in 11 s).
       const int first = n;
       add_frame(1);
-      n = static_cast<int>(out.candidates.size());
-      topologies.resize(n);
-      polycubes.resize(n);
-      turned.resize(n);
+      n = run_added(first, [&](int i) { build_fallback(i, larger); });
       maps.resize(n);
-      std::vector<int> added(n - first);
-      std::iota(added.begin(), added.end(), first);
-      parallel_for_each(added, options.threads, "orientation", [&](int i) { build_fallback(i, larger); });
       all.resize(n);
       std::iota(all.begin(), all.end(), 0);
     }

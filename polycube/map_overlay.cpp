@@ -299,84 +299,77 @@ void collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMe
     around[r].clear();
     return true;
   };
-  int collapses = 0;
-  for (int pass = 0; pass < 20; ++pass) {
-    int made = 0;
-    for (int f = 0; f < R.num_faces(); ++f) {
-      if (dead[f] || !tiny(f)) continue;
-      // Edges by length on both surfaces, shortest first; each tried both ways.
-      std::array<std::pair<double, int>, 3> edges;
-      for (int i = 0; i < 3; ++i) {
-        const int a = R.F(f, i), b = R.F(f, (i + 1) % 3);
-        edges[i] = {(R.V.row(a) - R.V.row(b)).norm() + (image.row(a) - image.row(b)).norm(), i};
-      }
-      std::sort(edges.begin(), edges.end());
-      for (const auto& [length, i] : edges) {
-        const int a = R.F(f, i), b = R.F(f, (i + 1) % 3);
-        if (try_collapse(a, b) || try_collapse(b, a)) {
-          ++made;
-          break;
+  // Passes over the tiny faces (at most 20, while some step succeeds): per face, `step(f, i)` on
+  // its edges i (from corner i to i + 1) by their length on both surfaces, shortest first or
+  // longest first, until one succeeds. Returns the successes.
+  const auto sweep = [&](bool longest_first, const auto& step) {
+    int total = 0;
+    for (int pass = 0; pass < 20; ++pass) {
+      int made = 0;
+      for (int f = 0; f < R.num_faces(); ++f) {
+        if (dead[f] || !tiny(f)) continue;
+        std::array<std::pair<double, int>, 3> edges;
+        for (int i = 0; i < 3; ++i) {
+          const int a = R.F(f, i), b = R.F(f, (i + 1) % 3);
+          const double length = (R.V.row(a) - R.V.row(b)).norm() + (image.row(a) - image.row(b)).norm();
+          edges[i] = {longest_first ? -length : length, i};
         }
+        std::sort(edges.begin(), edges.end());
+        for (const auto& [length, i] : edges)
+          if (step(f, i)) {
+            ++made;
+            break;
+          }
       }
+      total += made;
+      if (made == 0) break;
     }
-    collapses += made;
-    if (made == 0) break;
-  }
+    return total;
+  };
+  // Collapses first, each edge tried both ways.
+  const int collapses = sweep(false, [&](int f, int i) {
+    const int a = R.F(f, i), b = R.F(f, (i + 1) % 3);
+    return try_collapse(a, b) || try_collapse(b, a);
+  });
   // The tiny cells left: edge flips.
-  int flips = 0;
-  for (int pass = 0; pass < 20; ++pass) {
-    int made = 0;
-    for (int f = 0; f < R.num_faces(); ++f) {
-      if (dead[f] || !tiny(f)) continue;
-      std::array<std::pair<double, int>, 3> edges;
-      for (int i = 0; i < 3; ++i) {
-        const int a = R.F(f, i), b = R.F(f, (i + 1) % 3);
-        edges[i] = {-((R.V.row(a) - R.V.row(b)).norm() + (image.row(a) - image.row(b)).norm()), i};
-      }
-      std::sort(edges.begin(), edges.end());
-      for (const auto& [length, i] : edges) {
-        const int a = R.F(f, i), b = R.F(f, (i + 1) % 3), c = R.F(f, (i + 2) % 3);
-        int g = -1, d = -1;
-        for (int h : around[a]) {
-          if (dead[h] || h == f) continue;
-          for (int k = 0; k < 3; ++k)
-            if (R.F(h, k) == b && R.F(h, (k + 1) % 3) == a) {
-              g = h;
-              d = R.F(h, (k + 2) % 3);
-            }
+  const int flips = sweep(true, [&](int f, int i) {
+    const int a = R.F(f, i), b = R.F(f, (i + 1) % 3), c = R.F(f, (i + 2) % 3);
+    int g = -1, d = -1;
+    for (int h : around[a]) {
+      if (dead[h] || h == f) continue;
+      for (int k = 0; k < 3; ++k)
+        if (R.F(h, k) == b && R.F(h, (k + 1) % 3) == a) {
+          g = h;
+          d = R.F(h, (k + 2) % 3);
         }
-        if (g < 0 || out.face_image[g] != out.face_image[f]) continue;
-        // Both in one plane of P (one face of P, or two P triangles of one polycube face side by
-        // side: a P triangle the map squeezes to nothing is a single cell of P's own vertices).
-        const int pf = out.face_parent[f], pg = out.face_parent[g];
-        if (pf != pg && (p_normal[pf].dot(p_normal[pg]) < 1 - 1e-12 ||
-                         std::abs((R.V.row(d) - P.V.row(P.F(pf, 0))).dot(p_normal[pf])) > plane_tolerance))
-          continue;
-        neighbours(c, neighbours_r);
-        if (std::binary_search(neighbours_r.begin(), neighbours_r.end(), d)) continue;  // edge c-d exists
-        const int mf = out.face_image[f];
-        bool ok = true;
-        for (const auto& t : {std::array<int, 3>{c, a, d}, std::array<int, 3>{d, b, c}}) {
-          const Eigen::Vector3d on_p = area_vector(R.V, t[0], t[1], t[2]), on_m = area_vector(image, t[0], t[1], t[2]);
-          // Above the audit's degenerate area, and better than the tiny face on its tiny side.
-          ok = ok && on_p.dot(p_normal[pf]) > std::max(degenerate_p, std::min(tiny_p, area_vector(R.V, a, b, c).norm())) &&
-               on_m.dot(m_normal[mf]) > std::max(degenerate_m, std::min(tiny_m, area_vector(image, a, b, c).norm()));
-        }
-        if (!ok) continue;
-        R.F.row(f) << c, a, d;
-        R.F.row(g) << d, b, c;
-        // f left b and gained d, g left a and gained c.
-        around[b].erase(std::find(around[b].begin(), around[b].end(), f));
-        around[a].erase(std::find(around[a].begin(), around[a].end(), g));
-        around[d].push_back(f);
-        around[c].push_back(g);
-        ++made;
-        break;
-      }
     }
-    flips += made;
-    if (made == 0) break;
-  }
+    if (g < 0 || out.face_image[g] != out.face_image[f]) return false;
+    // Both in one plane of P (one face of P, or two P triangles of one polycube face side by
+    // side: a P triangle the map squeezes to nothing is a single cell of P's own vertices).
+    const int pf = out.face_parent[f], pg = out.face_parent[g];
+    if (pf != pg && (p_normal[pf].dot(p_normal[pg]) < 1 - 1e-12 ||
+                     std::abs((R.V.row(d) - P.V.row(P.F(pf, 0))).dot(p_normal[pf])) > plane_tolerance))
+      return false;
+    neighbours(c, neighbours_r);
+    if (std::binary_search(neighbours_r.begin(), neighbours_r.end(), d)) return false;  // edge c-d exists
+    const int mf = out.face_image[f];
+    bool ok = true;
+    for (const auto& t : {std::array<int, 3>{c, a, d}, std::array<int, 3>{d, b, c}}) {
+      const Eigen::Vector3d on_p = area_vector(R.V, t[0], t[1], t[2]), on_m = area_vector(image, t[0], t[1], t[2]);
+      // Above the audit's degenerate area, and better than the tiny face on its tiny side.
+      ok = ok && on_p.dot(p_normal[pf]) > std::max(degenerate_p, std::min(tiny_p, area_vector(R.V, a, b, c).norm())) &&
+           on_m.dot(m_normal[mf]) > std::max(degenerate_m, std::min(tiny_m, area_vector(image, a, b, c).norm()));
+    }
+    if (!ok) return false;
+    R.F.row(f) << c, a, d;
+    R.F.row(g) << d, b, c;
+    // f left b and gained d, g left a and gained c.
+    around[b].erase(std::find(around[b].begin(), around[b].end(), f));
+    around[a].erase(std::find(around[a].begin(), around[a].end(), g));
+    around[d].push_back(f);
+    around[c].push_back(g);
+    return true;
+  });
   out.collapsed = collapses;
   out.flipped_edges = flips;
   if (collapses + flips == 0) return;
