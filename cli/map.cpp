@@ -462,7 +462,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       nlohmann::json candidates = nlohmann::json::array();
       for (const AlignmentCandidate& c : alignment.candidates)
         candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle}, {"eps_area", c.eps_area},
-                              {"fallback_budget", c.fallback_budget}, {"failing_slabs", c.failing_slabs}, {"seconds", c.seconds}, {"error", c.error}});
+                              {"fallback_budget", c.fallback_budget}, {"failing_slabs", c.failing_slabs}, {"rasterized_cells", c.rasterized_cells}, {"seconds", c.seconds}, {"error", c.error}});
       alignment_report["candidates"] = candidates;
       alignment_report["proxy_faces"] = alignment.proxy_faces;
       if (alignment.proxy_faces > 0)

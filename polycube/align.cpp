@@ -3,6 +3,7 @@
 #include "polycube/errors.h"
 #include "polycube/map_audit.h"
 #include "polycube/parallel.h"
+#include "polycube/quadtree_raster.h"
 #include "polycube/simplify.h"
 
 #include <Eigen/Eigenvalues>
@@ -220,6 +221,11 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   scoring.max_inserted_planes = std::min(scoring.max_inserted_planes, options.max_inserted_planes);
   scoring.max_plane_cells = std::min(scoring.max_plane_cells, options.max_plane_cells);
   scoring.max_repair_level = std::min(scoring.max_repair_level, options.max_repair_level);
+  // The smaller positive limit of the caller's and the scoring's (0: none).
+  const auto cap = [](double caller, double budget) {
+    return caller > 0 && budget > 0 ? std::min(caller, budget) : std::max(caller, budget);
+  };
+  scoring.max_rasterized_cells = cap(polycube.max_rasterized_cells, options.max_rasterized_cells);
   // One factorised Laplacian for every candidate's harmonic function (they are turned copies of
   // one mesh); a mesh it cannot be built for fails in each candidate as before.
   std::unique_ptr<HarmonicSolver> harmonic;
@@ -235,6 +241,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   auto build = [&](int i, const PolycubeOptions& budget) {
     AlignmentCandidate& c = out.candidates[i];
     const auto start = std::chrono::steady_clock::now();
+    const long long work = rasterized_cells();
     try {
       if (turned[i].num_faces() == 0) turned[i] = rotated(scored, c.rotation);
       if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology, harmonic.get()));
@@ -250,6 +257,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       c.failing_slabs = 0;
       polycubes[i].reset();
     }
+    c.rasterized_cells = rasterized_cells() - work;
     c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   // Topology and polycube, under the scoring budget, of candidates [first, end).
@@ -271,6 +279,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   larger.max_inserted_planes = std::min(polycube.max_inserted_planes, 4 * scoring.max_inserted_planes);
   larger.max_plane_cells = std::min(polycube.max_plane_cells, 4 * scoring.max_plane_cells);
   larger.max_repair_level = std::min(polycube.max_repair_level, scoring.max_repair_level + 3);
+  larger.max_rasterized_cells = cap(polycube.max_rasterized_cells, 4 * options.max_rasterized_cells);
   auto build_fallback = [&](int i, const PolycubeOptions& budget) {
     out.candidates[i].error.clear();
     build(i, budget);

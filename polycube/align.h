@@ -33,6 +33,7 @@ namespace polycube {
 //            one), or as a near miss given a second chance (four times the budget)
 //   failing_slabs  when its last polycube build ran out of repair rounds (RepairRoundsExhausted):
 //            the slabs still failing; 0 otherwise
+//   rasterized_cells  grid cells its last polycube build's checks rasterized, passed or not
 struct AlignmentCandidate {
   std::string name;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
@@ -42,6 +43,7 @@ struct AlignmentCandidate {
   double eps_area = -1;
   bool fallback_budget = false;
   int failing_slabs = 0;
+  long long rasterized_cells = 0;  // the work of its last polycube build's checks (quadtree_raster.h)
   double seconds = 0;
   std::string error;
 };
@@ -109,6 +111,12 @@ struct AlignmentOptions {
   int max_inserted_planes = 30;
   int max_plane_cells = 4000;
   int max_repair_level = 12;
+  // Most grid cells a candidate's checks may rasterize (PolycubeOptions::max_rasterized_cells);
+  // 0: no limit. Measured (bench/map.md): every candidate that passes the scoring budget on the
+  // 63 shipped and unseen meshes rasterized at most 3.2e7 cells (5.0e7 at d_a 0.1), every one
+  // that passes four times the budget at most 8.0e7 (1.9e8 at d_a 0.1), about 1e7 a second;
+  // cheese turned off its axes spent 229–1 445 s per input-frame candidate.
+  double max_rasterized_cells = 5e8;
   // How many candidates (fewest corners first) get their map built and audited first; if all of
   // those still have flipped triangles, the rest are mapped too. 0: corners only.
   int mapped_candidates = 2;

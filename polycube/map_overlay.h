@@ -39,9 +39,8 @@ namespace polycube {
 //   collapsed     edges collapsed to remove cells too small for the audit (image or P area at
 //                 or below 1e-12 of the total): the shorter end merged into the other where the
 //                 mesh stays manifold and every moved triangle keeps its plane and orientation
-//   flipped_edges edges flipped to remove the tiny cells no collapse could: both faces in one plane
-//                 of P and one face of the model, both new triangles positive and above the
-//                 audit's degenerate area on both
+//   flipped_edges edges flipped to remove the tiny cells no collapse could: both faces in one face
+//                 of P and one of the model, both new triangles positive and not tiny on both
 //   uncovered_faces  P disk triangles whose cells do not sum to their area (to 1e-9): 0 unless
 //                 the walk over M's disk triangles missed some (a defect; the tests assert 0)
 struct MapOverlay {

@@ -5,6 +5,7 @@
 #include "polycube/plane_placement.h"
 #include "polycube/polycube_slab_check.h"
 #include "polycube/polycube_verify.h"
+#include "polycube/quadtree_raster.h"
 #include "polycube/quadtree_sampled.h"
 #include "polycube/quadtree_section.h"
 #include "polycube/quadtree_simplify.h"
@@ -139,6 +140,15 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
 
   PolycubeResult result;
   result.genus = topology.genus;
+  // The checks' work so far (quadtree_raster.h), against options.max_rasterized_cells.
+  const long long work_start = rasterized_cells();
+  const auto check_work = [&](const char* where) {
+    result.rasterized_cells = rasterized_cells() - work_start;
+    if (options.max_rasterized_cells > 0 && static_cast<double>(result.rasterized_cells) > options.max_rasterized_cells)
+      throw AlgorithmError("build_polycube: the checks rasterized " + std::to_string(result.rasterized_cells) +
+                           " cells " + where + ", more than the budget of " +
+                           std::to_string(static_cast<long long>(options.max_rasterized_cells)));
+  };
   const BoundingBox box = bounding_box(model.V);
   NormalisedFrame frame;
   frame.origin = box.min;
@@ -375,6 +385,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
       result.repairs.push_back(where.str() + "; inserted a plane at z = " + std::to_string(z));
     }
     result.seconds_checks += seconds_since(t);
+    check_work(("in " + std::to_string(round) + " rounds of repairs").c_str());
     if (failing == 0) break;
     if (round >= options.max_rounds)
       throw RepairRoundsExhausted("build_polycube: " + std::to_string(failing) + " slabs still fail after " +
@@ -445,6 +456,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
           coarsen_section(sections.planes[i], final_leaves[i], options.da, coarsest_level, slabs_pass(i));
       result.coarsening_merges += coarsened.merges;
       final_leaves[i] = std::move(coarsened.leaves);
+      check_work("while simplifying");
     }
     // Upwards, each plane following the one below; then downwards, following the one above.
     for (int pass = 0; pass < 2; ++pass)
@@ -454,6 +466,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
                                                 neighbour(i - 1), neighbour(i + 1), pass == 0, slabs_pass(i));
         result.snapped_cells += snapped.merges;
         final_leaves[i] = std::move(snapped.leaves);
+        check_work("while simplifying");
       }
   }
   result.seconds_simplify = seconds_since(t);
@@ -506,6 +519,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
   result.planes_z = sliced.planes;
   result.model_sliced = std::move(sliced);
   result.model_sections = std::move(sections);
+  result.rasterized_cells = rasterized_cells() - work_start;
   result.seconds_total = seconds_since(start);
   return result;
 }

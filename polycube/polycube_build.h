@@ -40,6 +40,10 @@ struct PolycubeOptions {
   int max_inserted_planes = 400;
   // Check-and-repair rounds before giving up.
   int max_rounds = 80;
+  // Most grid cells the checks may rasterize in total (quadtree_raster.h: their work, without a
+  // clock) before giving up; 0: no limit. A scoring budget for orientations whose sections are
+  // costly to check (a box with holes turned off its axes: minutes per candidate).
+  double max_rasterized_cells = 0;
   // Thinnest slab, as a fraction of the model's height, that may still get a plane inserted.
   double min_slab = 1e-5;
   // Once every slab passes, simplify the quadtrees wherever d_a, the sections' topology and both
@@ -103,6 +107,7 @@ struct PolycubeResult {
   double seconds_surface = 0;    // faces, edges and triangulation of P
   double seconds_verify = 0;     // final check of P
   double seconds_total = 0;
+  long long rasterized_cells = 0;  // grid cells the checks rasterized (quadtree_raster.h)
 };
 
 // Builds the polycube of §3.2 for a model and its topology stage:

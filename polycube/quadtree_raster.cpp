@@ -4,6 +4,11 @@
 
 namespace polycube {
 
+long long& rasterized_cells() {
+  thread_local long long cells = 0;
+  return cells;
+}
+
 QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections) {
   QuadRaster raster;
   for (const auto* leaves : sections)
@@ -26,6 +31,7 @@ QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections) 
     return static_cast<int>(std::lower_bound(lines.begin(), lines.end(), value) - lines.begin());
   };
   raster.leaf.resize(sections.size());
+  rasterized_cells() += static_cast<long long>(nx) * ny * static_cast<long long>(sections.size());
   for (size_t s = 0; s < sections.size(); ++s) {
     std::vector<int>& cells = raster.leaf[s];
     cells.assign(static_cast<size_t>(nx) * ny, -1);

@@ -28,6 +28,11 @@ struct QuadRaster {
 // Rasterizes the leaf sets (each covering the unit square) on their common grid.
 QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections);
 
+// Grid cells (nx × ny per leaf set) rasterize has filled on this thread so far: the work of the
+// sections' and slabs' checks, which rasterize every time, measured without a clock (the same on
+// every machine and run). build_polycube budgets it (PolycubeOptions::max_rasterized_cells).
+long long& rasterized_cells();
+
 // The faces of section s's leaves (its leaf list) on the raster's cells with the padding ring:
 // element (cy + 1) * (nx + 2) + cx + 1 for cell (cx, cy), face 0 (outside) in the padding. For
 // checks that look up neighbouring cells many times.

@@ -138,6 +138,25 @@ TEST(Align, FallsBackToALargerBudget) {
   EXPECT_EQ(a.rotation, w.rotation);
 }
 
+// The checks' work is part of the scoring budget: with room for almost none, every candidate
+// fails under it (and under four times it) with the budget named and its work reported, and the
+// caller's full budget, which has no such limit, still gives a polycube.
+TEST(Align, ChecksWorkIsPartOfTheScoringBudget) {
+  const TriMesh model = load_test_mesh("sphere.off");
+  AlignmentOptions options;
+  options.max_rasterized_cells = 1;
+  options.mapped_candidates = 0;
+  const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, options);
+  ASSERT_GE(a.chosen, 0);
+  ASSERT_TRUE(a.polycube);
+  EXPECT_GT(a.polycube->rasterized_cells, 4);
+  for (const AlignmentCandidate& c : a.candidates) {
+    EXPECT_GT(c.rasterized_cells, 0) << c.name;
+    if (c.corners < 0) EXPECT_NE(c.error.find("rasterized"), std::string::npos) << c.name << ": " << c.error;
+  }
+  EXPECT_TRUE(a.candidates[a.chosen].fallback_budget);
+}
+
 // A model above the proxy threshold is scored on a simplified copy (same genus); the winner's
 // topology and polycube are of the model itself, its map is left to the caller.
 TEST(Align, LargeModelsAreScoredOnASimplifiedCopy) {

@@ -166,6 +166,33 @@ TEST(Polycube, TiltedThinTorusNeedsAndGetsRepairs) {
   EXPECT_GT(result.planes_inserted + result.relabelled_cells + result.stacking_splits, 0);
 }
 
+// The checks' work is counted (grid cells rasterized, the same on every run) and budgeted: the
+// tilted torus with half the work it needs fails with the budget named; with the work it needs,
+// or no limit, it builds the same polycube.
+TEST(Polycube, ChecksWorkIsCountedAndBudgeted) {
+  TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
+  mesh.V = (mesh.V * R.transpose()).eval();
+  TopologyOptions coarse;
+  coarse.dz = 0.25;
+  const TopologyResult topology = analyse_topology(mesh, coarse);
+  const PolycubeResult free = build_polycube(mesh, topology);
+  ASSERT_GT(free.rasterized_cells, 0);
+  const PolycubeResult again = build_polycube(mesh, topology);
+  EXPECT_EQ(again.rasterized_cells, free.rasterized_cells);
+  PolycubeOptions budget;
+  budget.max_rasterized_cells = static_cast<double>(free.rasterized_cells);
+  const PolycubeResult enough = build_polycube(mesh, topology, budget);
+  EXPECT_EQ(enough.polycube.corners.size(), free.polycube.corners.size());
+  budget.max_rasterized_cells = 0.5 * static_cast<double>(free.rasterized_cells);
+  try {
+    build_polycube(mesh, topology, budget);
+    ADD_FAILURE() << "built within half the work it needs";
+  } catch (const AlgorithmError& e) {
+    EXPECT_NE(std::string(e.what()).find("rasterized"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Polycube, ReslicesTheTopologyStagesSurfaceWhenItWasChanged) {
   // When the topology stage split degenerate saddles, its sliced mesh is not the input: inserted
   // planes must cut the surface it sliced, recovered from its refined mesh. Pretend so on a mesh
