@@ -186,6 +186,7 @@ nlohmann::json polycube_json(const PolycubeResult& result) {
           {"relabelled_cells", result.relabelled_cells},
           {"simplification", {{"merged_cells", result.coarsening_merges}, {"snapped_cells", result.snapped_cells}}},
           {"rounds", result.rounds},
+          {"rasterized_cells", result.rasterized_cells},
           {"deepest_level", result.deepest_level},
           {"max_region_area_error", result.max_region_error},
           {"repairs", result.repairs},

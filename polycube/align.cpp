@@ -10,11 +10,11 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
-#include <chrono>
-#include <tuple>
 #include <numeric>
+#include <tuple>
 
 namespace polycube {
 
@@ -260,7 +260,6 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     c.rasterized_cells = rasterized_cells() - work;
     c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
-  // Topology and polycube, under the scoring budget, of candidates [first, end).
   // Runs `step` on the candidates [first, end) (those just added), in parallel; returns end.
   auto run_added = [&](int first, const std::function<void(int)>& step) {
     const int end = static_cast<int>(out.candidates.size());
@@ -272,6 +271,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     parallel_for_each(order, options.threads, "orientation", step);
     return end;
   };
+  // Topology and polycube, under the scoring budget, of candidates [first, end).
   auto score = [&](int first) { run_added(first, [&](int i) { build(i, scoring); }); };
   // Four times the scoring budget (capped by the caller's), for candidates given a second chance.
   PolycubeOptions larger = polycube;
@@ -412,8 +412,6 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       add_frame(1);
       n = run_added(first, [&](int i) { build_fallback(i, larger); });
       maps.resize(n);
-      all.resize(n);
-      std::iota(all.begin(), all.end(), 0);
     }
     for (int i = 0; i < n; ++i)
       if (polycubes[i] && (out.chosen < 0 || out.candidates[i].corners < out.candidates[out.chosen].corners)) out.chosen = i;

@@ -142,7 +142,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
   result.genus = topology.genus;
   // The checks' work so far (quadtree_raster.h), against options.max_rasterized_cells.
   const long long work_start = rasterized_cells();
-  const auto check_work = [&](const char* where) {
+  const auto check_work = [&](const std::string& where) {
     result.rasterized_cells = rasterized_cells() - work_start;
     if (options.max_rasterized_cells > 0 && static_cast<double>(result.rasterized_cells) > options.max_rasterized_cells)
       throw AlgorithmError("build_polycube: the checks rasterized " + std::to_string(result.rasterized_cells) +
@@ -385,7 +385,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
       result.repairs.push_back(where.str() + "; inserted a plane at z = " + std::to_string(z));
     }
     result.seconds_checks += seconds_since(t);
-    check_work(("in " + std::to_string(round) + " rounds of repairs").c_str());
+    check_work("in " + std::to_string(round) + " rounds of repairs");
     if (failing == 0) break;
     if (round >= options.max_rounds)
       throw RepairRoundsExhausted("build_polycube: " + std::to_string(failing) + " slabs still fail after " +
