@@ -150,15 +150,24 @@ TEST(Polycube, SmallTestMeshes) {
   }
 }
 
-// A tilted torus: its cross-sections move sideways from plane to plane, so extrusions of
-// neighbouring planes touch or miss each other unless the repairs step in.
-TEST(Polycube, TiltedThinTorusNeedsAndGetsRepairs) {
+// A thin torus tilted off the axes, and its topology with coarse planes: its cross-sections move
+// sideways from plane to plane, so extrusions of neighbouring planes touch or miss each other
+// unless the repairs step in.
+TriMesh tilted_thin_torus() {
   TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
   const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
   mesh.V = (mesh.V * R.transpose()).eval();
+  return mesh;
+}
+TopologyOptions coarse_planes() {
   TopologyOptions coarse;
   coarse.dz = 0.25;
-  const TopologyResult topology = analyse_topology(mesh, coarse);
+  return coarse;
+}
+
+TEST(Polycube, TiltedThinTorusNeedsAndGetsRepairs) {
+  const TriMesh mesh = tilted_thin_torus();
+  const TopologyResult topology = analyse_topology(mesh, coarse_planes());
   const PolycubeResult result = build(mesh, topology);
   expect_valid_polycube(topology, result);
   EXPECT_FALSE(result.repairs.empty());
@@ -170,12 +179,8 @@ TEST(Polycube, TiltedThinTorusNeedsAndGetsRepairs) {
 // tilted torus with half the work it needs fails with the budget named; with the work it needs,
 // or no limit, it builds the same polycube.
 TEST(Polycube, ChecksWorkIsCountedAndBudgeted) {
-  TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
-  mesh.V = (mesh.V * R.transpose()).eval();
-  TopologyOptions coarse;
-  coarse.dz = 0.25;
-  const TopologyResult topology = analyse_topology(mesh, coarse);
+  const TriMesh mesh = tilted_thin_torus();
+  const TopologyResult topology = analyse_topology(mesh, coarse_planes());
   const PolycubeResult free = build_polycube(mesh, topology);
   ASSERT_GT(free.rasterized_cells, 0);
   const PolycubeResult again = build_polycube(mesh, topology);
@@ -197,12 +202,8 @@ TEST(Polycube, ReslicesTheTopologyStagesSurfaceWhenItWasChanged) {
   // When the topology stage split degenerate saddles, its sliced mesh is not the input: inserted
   // planes must cut the surface it sliced, recovered from its refined mesh. Pretend so on a mesh
   // that needs inserted planes; the result must be the same as from the input.
-  TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
-  mesh.V = (mesh.V * R.transpose()).eval();
-  TopologyOptions coarse;
-  coarse.dz = 0.25;
-  TopologyResult topology = analyse_topology(mesh, coarse);
+  const TriMesh mesh = tilted_thin_torus();
+  TopologyResult topology = analyse_topology(mesh, coarse_planes());
   const PolycubeResult direct = build(mesh, topology);
   ASSERT_GT(direct.planes_inserted, 0);
   topology.split_saddles = 1;
@@ -399,12 +400,8 @@ TEST(Polycube, RejectsBadOptions) {
 TEST(Polycube, GivesUpWithAClearErrorWithinItsLimits) {
   // The tilted thin torus needs repairs; with a single round allowed the stage must fail with
   // AlgorithmError rather than return an invalid polycube.
-  TriMesh mesh = test::make_torus(1.0, 0.1, 96, 16);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.2, Eigen::Vector3d(1, 0.3, 0).normalized()).toRotationMatrix();
-  mesh.V = (mesh.V * R.transpose()).eval();
-  TopologyOptions coarse;
-  coarse.dz = 0.25;
-  const TopologyResult topology = analyse_topology(mesh, coarse);
+  const TriMesh mesh = tilted_thin_torus();
+  const TopologyResult topology = analyse_topology(mesh, coarse_planes());
   PolycubeOptions options;
   options.max_rounds = 1;
   try {
