@@ -195,7 +195,7 @@ Eigen::Vector3d on_surface(const DiskEmbedding& disk, int f, const Eigen::Vector
 // Cells too small for the audit (image or P area at or below kTinyArea of the total): their
 // shortest edges collapsed, the removed end never one of P's own vertices, only where the mesh
 // stays a manifold (link condition) and every triangle moved stays in its P face's plane and in
-// its model face (to a tenth of the audit's in-face tolerance); a moved triangle the audit passes
+// its model face (to a tenth of the audit's in-face tolerance); a moved triangle that is not tiny
 // must keep its orientation on both and not become tiny, a tiny one must not turn over by more
 // than the audit's degenerate area (a cluster of tiny cells where an edge of P, an edge of the
 // model and a cutting plane meet merges step by step: cheese had 10 image triangles below the
@@ -274,7 +274,7 @@ void collapse_tiny_cells(MapOverlay& out, int own, const TriMesh& P, const TriMe
       const Eigen::Vector3d on_p = area_vector(R.V, c[0], c[1], c[2]), on_m = area_vector(image, c[0], c[1], c[2]);
       const Eigen::Vector3d old_p = area_vector(R.V, R.F(f, 0), R.F(f, 1), R.F(f, 2)), old_m = area_vector(image, R.F(f, 0), R.F(f, 1), R.F(f, 2));
       if (old_p.norm() > tiny_p && old_m.norm() > tiny_m) {
-        // A triangle the audit passes stays so.
+        // A triangle that is not tiny keeps its orientation and stays not tiny.
         if (!(on_p.dot(p_normal[parent]) > tiny_p)) return false;
         if (!(on_m.norm() > tiny_m)) return false;
         if (!(on_m.dot(m_normal[out.face_image[f]]) > 0)) return false;
