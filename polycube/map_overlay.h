@@ -38,7 +38,9 @@ namespace polycube {
 //                 the other), triangulated all the same: their neighbours share their corners
 //   collapsed     edges collapsed to remove cells too small for the audit (image or P area at
 //                 or below 1e-12 of the total): the shorter end merged into the other where the
-//                 mesh stays manifold and every moved triangle keeps its plane and orientation
+//                 mesh stays manifold and every moved triangle keeps its plane and model face,
+//                 those not tiny their orientation (tiny ones may turn by at most the audit's
+//                 degenerate area: they are removed in turn)
 //   flipped_edges edges flipped to remove the tiny cells no collapse could: both faces in one face
 //                 of P and one of the model, both new triangles positive and not tiny on both
 //   uncovered_faces  P disk triangles whose cells do not sum to their area (to 1e-9): 0 unless

@@ -3,6 +3,7 @@
 #include "polycube/barycentric.h"
 #include "polycube/closest_point.h"
 #include "polycube/image_orientation.h"
+#include "polycube/map_audit.h"
 #include "polycube/max_min_affine.h"
 
 #include "polycube/mesh_topology.h"
@@ -794,8 +795,6 @@ using Triangle = Kernel::Triangle_3;
 using TriangleIterator = std::vector<Triangle>::const_iterator;
 using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
 using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
-
-constexpr double kAuditDegenerateArea = 1e-14;  // × target area, as the audit
 
 class AuditTarget {
  public:
