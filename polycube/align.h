@@ -113,8 +113,9 @@ struct AlignmentOptions {
   int max_repair_level = 12;
   // Most grid cells a candidate's checks may rasterize (PolycubeOptions::max_rasterized_cells);
   // 0: no limit. Measured (bench/map.md): every candidate that passes the scoring budget on the
-  // 63 shipped and unseen meshes rasterized at most 3.2e7 cells (5.0e7 at d_a 0.1), every one
-  // that passes four times the budget at most 8.0e7 (1.9e8 at d_a 0.1), about 1e7 a second;
+  // 63 shipped and unseen meshes rasterized at most 3.2e7 cells, every one that passes four times
+  // the budget at most 8.0e7 (at d_a 0.1, on cow, femur, 3torus, bull, mpi, camel, dino: 5.0e7 and
+  // 1.9e8); the checks rasterize 1–2e7 cells a second;
   // cheese turned off its axes spent 229–1 445 s per input-frame candidate.
   double max_rasterized_cells = 5e8;
   // How many candidates (fewest corners first) get their map built and audited first; if all of
