@@ -448,6 +448,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                            {"converged", result.smoothing.converged}, {"largest_move", result.smoothing.largest_move}};
     report["fitting"] = {{"passes", result.fitting.passes},
                          {"snapped", result.fitting.snapped},
+                         {"stretched", result.fitting.stretched},
                          {"farthest_before", result.fitting.farthest_before},
                          {"farthest_after", result.fitting.farthest_after},
                          {"relaxation_sweeps", result.refitting.sweeps}};

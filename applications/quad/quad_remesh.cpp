@@ -154,7 +154,8 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         pass.refitting.mesh = QuadMesh{};
       }
       pass.seconds_fit += since(begin);
-      say("fit", std::to_string(pass.fitting.snapped) + " corners pulled, farthest model point " +
+      say("fit", std::to_string(pass.fitting.snapped) + " corners pulled (" + std::to_string(pass.fitting.stretched) +
+                     " with rings following), farthest model point " +
                      format("%.4g -> %.4g from the quads", pass.fitting.farthest_before, pass.fitting.farthest_after));
     }
     if (options.untangle.passes > 0) {

@@ -440,6 +440,8 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
                         const std::vector<char>& pinned) {
   const auto start = std::chrono::steady_clock::now();
   if (options.passes < 0) throw std::invalid_argument("fitting passes must be >= 0, got " + std::to_string(options.passes));
+  if (options.stretch_rings < 0)
+    throw std::invalid_argument("fitting stretch_rings must be >= 0, got " + std::to_string(options.stretch_rings));
   if (!(options.tolerance >= 0) || !(options.reach > 0) || !(options.max_corner_deviation >= 0))
     throw std::invalid_argument("fitting tolerance and max_corner_deviation must be >= 0 and reach > 0, got " +
                                 std::to_string(options.tolerance) + ", " + std::to_string(options.max_corner_deviation) + ", " +
@@ -496,9 +498,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   auto farthest = [&]() { return distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end()); };
   // How far v's quads stray from the model: the largest distance of their edge midpoints and of
   // the centres of their two triangles (split as the measure splits them).
-  auto off_model = [&](int v) {
+  auto off_model = [&](const std::vector<int>& quads) {
     double off = 0;
-    for (int q : around[v]) {
+    for (int q : quads) {
       Eigen::Vector3d p[4];
       for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
       const auto t = quad_triangle_corners(mesh, q);
@@ -508,10 +510,143 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     }
     return off;
   };
+  // Whether the model points owned by `quads` (all moved) stay within max(limit, their distance)
+  // of the quads round those quads' corners (an upper bound of their distance to the whole mesh);
+  // moved_to gets each one's nearest quad and distance, in the order of recheck.
+  std::vector<int> nearby, recheck;
+  std::vector<std::pair<int, double>> moved_to;
+  auto still_covered = [&](const std::vector<int>& quads, double limit) {
+    nearby.clear();
+    for (int q : quads)
+      for (int k = 0; k < 4; ++k)
+        for (int r : around[mesh.Q(q, k)]) nearby.push_back(r);
+    std::sort(nearby.begin(), nearby.end());
+    nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
+    recheck.clear();
+    for (int q : quads) recheck.insert(recheck.end(), owned[q].begin(), owned[q].end());
+    moved_to.clear();
+    for (const int y : recheck) {
+      int nearest = -1;
+      double d = INFINITY;
+      for (int r : nearby) {
+        const double dr = quad_distance(r, points[y]);
+        if (dr < d) {
+          d = dr;
+          nearest = r;
+        }
+      }
+      if (!(d <= std::max(limit, distance[y]))) return false;
+      moved_to.emplace_back(nearest, d);
+    }
+    return true;
+  };
+  // The rechecked points' new distances and quads (after still_covered accepted).
+  auto take_rechecked = [&]() {
+    for (size_t i = 0; i < recheck.size(); ++i) {
+      const int y = recheck[i];
+      std::vector<int>& from = owned[owner[y]];
+      from.erase(std::find(from.begin(), from.end(), y));
+      owner[y] = moved_to[i].first;
+      distance[y] = moved_to[i].second;
+      owned[owner[y]].push_back(y);
+    }
+  };
+  // A point beyond the reach of every corner (a tip the map squeezed: the quads there are small
+  // and stop short of it): the nearest free corner of its quad is pulled onto it and the vertices
+  // within R rings of it follow, ring r by (1 - r / (R + 1)) of the pull, each placed on its own
+  // sheet (closest_on_sheet), R the pull over the corner's mean edge length (at most
+  // stretch_rings), so the quads between stretch by about one edge each instead of one quad by
+  // the whole pull. Taken when no quad round a moved vertex loses a bit of its guard state and the
+  // model points stay covered (as for a single pull); the corner is pinned.
+  std::vector<int> ring_of(nv, -1), slot(nv, -1), region, touched;
+  std::vector<Eigen::Vector3d> region_old;
+  std::vector<int> touched_state;
+  std::vector<SurfaceHit> touched_hit;
+  auto stretch = [&](int w, double limit) {
+    const Eigen::Vector3d& x = points[w];
+    int v = -1;
+    double best = INFINITY;
+    for (int k = 0; k < 4; ++k) {
+      const int c = mesh.Q(owner[w], k);
+      const double d = (mesh.V.row(c).transpose() - x).norm();
+      if (!result.pinned[c] && d < best) {
+        best = d;
+        v = c;
+      }
+    }
+    if (v < 0 || neighbours[v].empty()) return false;
+    double edge = 0;
+    for (int u : neighbours[v]) edge += (mesh.V.row(u) - mesh.V.row(v)).norm() / neighbours[v].size();
+    if (!(edge > 0)) return false;
+    const int rings = std::clamp(static_cast<int>(std::ceil(best / edge)), 1, options.stretch_rings);
+    const Eigen::Vector3d pull = x - mesh.V.row(v).transpose();
+    // The region, ring by ring (pinned vertices stay and are not passed through).
+    region.assign(1, v);
+    ring_of[v] = 0;
+    for (size_t i = 0; i < region.size(); ++i) {
+      const int u = region[i];
+      if (ring_of[u] == rings) continue;
+      for (int t : neighbours[u])
+        if (ring_of[t] < 0 && !result.pinned[t]) {
+          ring_of[t] = ring_of[u] + 1;
+          region.push_back(t);
+        }
+    }
+    touched.clear();
+    for (int u : region) touched.insert(touched.end(), around[u].begin(), around[u].end());
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    const double off_before = off_model(touched);
+    region_old.clear();
+    for (size_t i = 0; i < region.size(); ++i) {
+      region_old.push_back(mesh.V.row(region[i]));
+      slot[region[i]] = static_cast<int>(i);
+    }
+    const auto undo = [&]() {
+      for (size_t i = 0; i < region.size(); ++i) {
+        mesh.V.row(region[i]) = region_old[i];
+        ring_of[region[i]] = -1;
+      }
+      return false;
+    };
+    for (size_t i = 1; i < region.size(); ++i) {
+      const int u = region[i];
+      const double share = 1 - static_cast<double>(ring_of[u]) / (rings + 1);
+      const SurfaceHit from = surface.closest(region_old[i]);
+      mesh.V.row(u) = surface.closest_on_sheet(region_old[i] + share * pull, from).point;
+    }
+    mesh.V.row(v) = x;
+    // No edge shortened below kShortestEdge of the mean quad size.
+    const auto old_position = [&](int t) -> Eigen::Vector3d {
+      return ring_of[t] < 0 ? Eigen::Vector3d(mesh.V.row(t)) : region_old[slot[t]];
+    };
+    for (int u : region)
+      for (int t : neighbours[u]) {
+        const double now = (mesh.V.row(t) - mesh.V.row(u)).norm();
+        if (now < kShortestEdge * size && now < (old_position(t) - old_position(u)).norm()) return undo();
+      }
+    touched_state.clear();
+    touched_hit.clear();
+    for (int q : touched) {
+      touched_hit.push_back(quad_hit[q]);
+      touched_state.push_back(guard.state(q, touched_hit.back(), size));
+      if (quad_state[q] & ~touched_state.back()) return undo();
+    }
+    if (off_model(touched) > std::max(tolerance, off_before) || !still_covered(touched, limit)) return undo();
+    for (size_t i = 0; i < touched.size(); ++i) {
+      quad_state[touched[i]] = touched_state[i];
+      quad_hit[touched[i]] = touched_hit[i];
+    }
+    take_rechecked();
+    for (int u : region) ring_of[u] = -1;
+    distance[w] = 0;
+    result.pinned[v] = 1;
+    ++result.stretched;
+    return true;
+  };
   measure_all();
   result.farthest_before = farthest();
-  std::vector<int> after, nearby, recheck;
-  std::vector<std::pair<int, double>> moved_to;
+  std::vector<int> after;
   std::vector<SurfaceHit> after_hit;
   for (int pass = 0; pass < options.passes; ++pass) {
     // The model's points beyond the tolerance, farthest first.
@@ -537,12 +672,15 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
           v = c;
         }
       }
-      if (v < 0) continue;
+      if (v < 0) {
+        if (options.stretch_rings > 0 && stretch(w, limit)) ++snapped;
+        continue;
+      }
       bool collapses = false;
       for (int u : neighbours[v]) collapses |= (mesh.V.row(u).transpose() - x).norm() < kShortestEdge * size;
       if (collapses) continue;
       const Eigen::Vector3d old = mesh.V.row(v);
-      const double off_before = off_model(v);
+      const double off_before = off_model(around[v]);
       mesh.V.row(v) = x;
       bool accepted = true;
       after.clear();
@@ -553,7 +691,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
         accepted = (quad_state[around[v][k]] & ~after.back()) == 0;
       }
       // Nor may v's quads move off the model: sampled, no farther than the tolerance or than before.
-      if (accepted) accepted = off_model(v) <= std::max(tolerance, off_before);
+      if (accepted) accepted = off_model(around[v]) <= std::max(tolerance, off_before);
       // Nor may a corner of its quads bend farther from 90° than the limit (and than before).
       for (size_t k = 0; k < around[v].size() && accepted; ++k) {
         const int q = around[v][k];
@@ -568,34 +706,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
           accepted = now <= options.max_corner_deviation || now <= deviation(old);
         }
       }
-      // Nor may the place v leaves be uncovered: the model vertices closest to v's quads must stay
-      // within the farthest distance of the pass (measured to the quads round v's quads' corners,
-      // an upper bound of their distance to the whole mesh).
-      moved_to.clear();
-      if (accepted) {
-        nearby.clear();
-        for (int q : around[v])
-          for (int k = 0; k < 4; ++k)
-            for (int r : around[mesh.Q(q, k)]) nearby.push_back(r);
-        std::sort(nearby.begin(), nearby.end());
-        nearby.erase(std::unique(nearby.begin(), nearby.end()), nearby.end());
-        recheck.clear();
-        for (int q : around[v]) recheck.insert(recheck.end(), owned[q].begin(), owned[q].end());
-        for (size_t i = 0; i < recheck.size() && accepted; ++i) {
-          const Eigen::Vector3d& y = points[recheck[i]];
-          int nearest = -1;
-          double d = INFINITY;
-          for (int r : nearby) {
-            const double dr = quad_distance(r, y);
-            if (dr < d) {
-              d = dr;
-              nearest = r;
-            }
-          }
-          accepted = d <= std::max(limit, distance[recheck[i]]);
-          moved_to.emplace_back(nearest, d);
-        }
-      }
+      // Nor may the place v leaves be uncovered: the model points closest to v's quads must stay
+      // within the farthest distance of the pass.
+      if (accepted) accepted = still_covered(around[v], limit);
       if (!accepted) {
         mesh.V.row(v) = old;
         continue;
@@ -604,15 +717,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
         quad_state[around[v][k]] = after[k];
         quad_hit[around[v][k]] = after_hit[k];
       }
-      // The rechecked model vertices' new distances and quads.
-      for (size_t i = 0; i < recheck.size(); ++i) {
-        const int y = recheck[i];
-        std::vector<int>& from = owned[owner[y]];
-        from.erase(std::find(from.begin(), from.end(), y));
-        owner[y] = moved_to[i].first;
-        distance[y] = moved_to[i].second;
-        owned[owner[y]].push_back(y);
-      }
+      take_rechecked();
       distance[w] = 0;
       result.pinned[v] = 1;
       ++snapped;

@@ -109,6 +109,13 @@ struct QuadFitOptions {
   // A pull is refused when it bends a corner of the vertex's quads more than this many degrees
   // away from 90° (unless that corner was bent farther before).
   double max_corner_deviation = 60;
+  // A point farther than `reach` from every corner of its quad (a tip the map squeezed, the quads
+  // round it small and short of it): the nearest corner is pulled onto it with the vertices
+  // within up to this many rings following by less and less, so the pull spreads over a few
+  // quads (no corner-angle limit: a tip's corner is sharp; the guard, the covering and the bound
+  // on the quads' distance off the model still hold, over all the quads moved). 0: such points
+  // are left.
+  int stretch_rings = 8;
 };
 
 //   mesh       the fitted quads (same connectivity)
@@ -121,6 +128,7 @@ struct QuadFitResult {
   QuadMesh mesh;
   std::vector<char> pinned;
   int snapped = 0;
+  int stretched = 0;  // of the snapped, pulled with rings following (QuadFitOptions::stretch_rings)
   int passes = 0;
   double farthest_before = 0, farthest_after = 0;
   double seconds = 0;

@@ -283,6 +283,9 @@ QuadRemeshOptions horn_options(int quads, int rounds) {
   options.grid.target_quads = quads;
   options.smooth.sweeps = 10;
   options.refine.rounds = rounds;
+  // The fit's single pulls only: the refinement tests need a horn the quads miss, and the pulls
+  // with rings following reach much of it (HornIsReachedByTheFitsStretch).
+  options.fit.stretch_rings = 0;
   return options;
 }
 
@@ -318,6 +321,24 @@ TEST(QuadCarry, RefinementReachesIntoAHorn) {
   EXPECT_EQ(refined.quality.flipped_quads, 0);
   EXPECT_EQ(refined.quality.degenerate_quads, 0);
   EXPECT_LE(refined.quality.max_distance_to_surface, 1e-9 * refined.quality.diagonal);
+}
+
+// Without refinement, the fit's pulls with rings following reach into the horn that the single
+// pulls leave: the quads come nearer the model, with nothing flipped.
+TEST(QuadCarry, HornIsReachedByTheFitsStretch) {
+  QuadRemeshOptions options = horn_options(1500, 0);
+  const QuadRemeshResult single = remesh_horn(options);
+  options.fit.stretch_rings = QuadFitOptions{}.stretch_rings;
+  const QuadRemeshResult stretched = remesh_horn(options);
+  EXPECT_EQ(single.fitting.stretched, 0);
+  EXPECT_GE(stretched.fitting.stretched, 1);
+  EXPECT_GT(single.quality.model_to_quads, 0.006 * single.quality.diagonal);
+  EXPECT_LT(stretched.quality.model_to_quads, 0.8 * single.quality.model_to_quads);
+  EXPECT_EQ(stretched.quality.quads, single.quality.quads);
+  EXPECT_EQ(stretched.quality.flipped_quads, 0);
+  EXPECT_EQ(stretched.quality.degenerate_quads, 0);
+  EXPECT_EQ(stretched.quality.irregular_vertices, 8);
+  EXPECT_LE(stretched.quality.max_distance_to_surface, 1e-9 * stretched.quality.diagonal);
 }
 
 // The bound: when the rounds and the budget are spent with the quads still farther from the model
@@ -574,7 +595,9 @@ TEST(QuadCarry, FitPullsACornerOntoATip) {
   const QuadQuality before = measure_quads(quads, model, c.grid.corners);
   ASSERT_EQ(before.flipped_quads, 0);
 
-  const QuadFitResult fit = fit_quads(quads, model);
+  QuadFitOptions single;  // no ring follows (FitStretchesTheQuadsOntoAFarTip)
+  single.stretch_rings = 0;
+  const QuadFitResult fit = fit_quads(quads, model, single);
   EXPECT_EQ(fit.mesh.Q, quads.Q);
   EXPECT_GE(fit.snapped, 1);
   EXPECT_EQ(std::count(fit.pinned.begin(), fit.pinned.end(), 1), fit.snapped);
@@ -616,6 +639,57 @@ TEST(QuadCarry, FitPullsACornerOntoATip) {
   EXPECT_THROW(fit_quads(quads, model, {}, std::vector<char>(3, 0)), std::invalid_argument);
   QuadFitOptions bad;
   bad.reach = 0;
+  EXPECT_THROW(fit_quads(quads, model, bad), std::invalid_argument);
+}
+
+// A tip far beyond the reach of one pull (a horn the map squeezed: the quads round it stop
+// short): the nearest corner is pulled onto it with a few rings of vertices following, so the
+// quads reach the tip without a flip, and the vertices farther away stay where they were.
+TEST(QuadCarry, FitStretchesTheQuadsOntoAFarTip) {
+  const CubeSphere c = cube_sphere(1500);
+  TriMesh spiked = test::make_sphere(4);
+  const double size = std::sqrt(4 * M_PI / c.quads.num_quads());
+  // A horn: the sphere raised by four quad sizes at its tip, falling off over about two.
+  const int tip = 0;
+  const Eigen::Vector3d axis = spiked.V.row(tip).normalized();
+  for (int v = 0; v < spiked.num_vertices(); ++v) {
+    const double r = (spiked.V.row(v).normalized().transpose() - axis).norm();
+    spiked.V.row(v) *= 1 + 4 * size * std::exp(-(r * r) / (4 * size * size));
+  }
+  const SurfaceProjector model(spiked);
+  QuadMesh quads = c.quads;
+  for (int v = 0; v < quads.num_vertices(); ++v) quads.V.row(v) = model.closest(quads.V.row(v).transpose()).point;
+  const QuadQuality before = measure_quads(quads, model, c.grid.corners);
+  ASSERT_EQ(before.flipped_quads, 0);
+  ASSERT_GT(before.model_to_quads, 2 * size);
+
+  QuadFitOptions single;
+  single.stretch_rings = 0;
+  const QuadFitResult short_of = fit_quads(quads, model, single);
+  EXPECT_EQ(short_of.stretched, 0);
+  EXPECT_GT(short_of.farthest_after, 2 * size) << "one pull alone does not reach the tip";
+
+  const QuadFitResult fit = fit_quads(quads, model);
+  EXPECT_GE(fit.stretched, 1);
+  EXPECT_LE(fit.stretched, fit.snapped);
+  EXPECT_LT(fit.farthest_after, 0.5 * size);
+  int on_tip = 0;
+  for (int v = 0; v < fit.mesh.num_vertices(); ++v) on_tip += fit.mesh.V.row(v) == spiked.V.row(tip);
+  EXPECT_EQ(on_tip, 1) << "one corner sits on the tip";
+  int moved = 0;
+  for (int v = 0; v < fit.mesh.num_vertices(); ++v) {
+    if (fit.mesh.V.row(v) == quads.V.row(v)) continue;
+    ++moved;
+    EXPECT_LT((quads.V.row(v) - spiked.V.row(tip)).norm(), 12 * size) << "only vertices near the tip move";
+  }
+  EXPECT_GT(moved, fit.snapped) << "rings followed the pulled corner";
+  const QuadQuality after = measure_quads(fit.mesh, model, c.grid.corners);
+  EXPECT_EQ(after.flipped_quads, 0);
+  EXPECT_EQ(after.degenerate_quads, 0);
+  EXPECT_LE(after.max_distance_to_surface, 1e-9);
+  EXPECT_LT(after.model_to_quads, 0.25 * before.model_to_quads);
+  QuadFitOptions bad;
+  bad.stretch_rings = -1;
   EXPECT_THROW(fit_quads(quads, model, bad), std::invalid_argument);
 }
 

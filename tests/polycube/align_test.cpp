@@ -152,7 +152,9 @@ TEST(Align, ChecksWorkIsPartOfTheScoringBudget) {
   EXPECT_GT(a.polycube->rasterized_cells, 4);
   for (const AlignmentCandidate& c : a.candidates) {
     EXPECT_GT(c.rasterized_cells, 0) << c.name;
-    if (c.corners < 0) EXPECT_NE(c.error.find("rasterized"), std::string::npos) << c.name << ": " << c.error;
+    if (c.corners < 0) {
+      EXPECT_NE(c.error.find("rasterized"), std::string::npos) << c.name << ": " << c.error;
+    }
   }
   EXPECT_TRUE(a.candidates[a.chosen].fallback_budget);
 }
