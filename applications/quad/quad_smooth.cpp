@@ -551,6 +551,17 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
       owned[owner[y]].push_back(y);
     }
   };
+  // The corner of point w's closest quad nearest to it, not pinned, nearer than `within`, and its
+  // distance (-1: none).
+  auto nearest_free_corner = [&](int w, double within) {
+    std::pair<int, double> nearest{-1, within};
+    for (int k = 0; k < 4; ++k) {
+      const int c = mesh.Q(owner[w], k);
+      const double d = (mesh.V.row(c).transpose() - points[w]).norm();
+      if (!result.pinned[c] && d < nearest.second) nearest = {c, d};
+    }
+    return nearest;
+  };
   // A point beyond the reach of every corner (a tip the map squeezed: the quads there are small
   // and stop short of it): the nearest free corner of its quad is pulled onto it and the vertices
   // within R rings of it follow, ring r by (1 - r / (R + 1)) of the pull, each placed on its own
@@ -564,16 +575,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   std::vector<SurfaceHit> touched_hit;
   auto stretch = [&](int w, double limit) {
     const Eigen::Vector3d& x = points[w];
-    int v = -1;
-    double best = INFINITY;
-    for (int k = 0; k < 4; ++k) {
-      const int c = mesh.Q(owner[w], k);
-      const double d = (mesh.V.row(c).transpose() - x).norm();
-      if (!result.pinned[c] && d < best) {
-        best = d;
-        v = c;
-      }
-    }
+    const auto [v, best] = nearest_free_corner(w, INFINITY);
     if (v < 0 || neighbours[v].empty()) return false;
     double edge = 0;
     for (int u : neighbours[v]) edge += (mesh.V.row(u) - mesh.V.row(v)).norm() / neighbours[v].size();
@@ -662,16 +664,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
       if (!(distance[w] > tolerance)) continue;  // an earlier pull covered it
       const Eigen::Vector3d& x = points[w];
       // The nearest corner of the quad the point is closest to, within reach.
-      int v = -1;
-      double best = options.reach * size;
-      for (int k = 0; k < 4; ++k) {
-        const int c = mesh.Q(owner[w], k);
-        const double d = (mesh.V.row(c).transpose() - x).norm();
-        if (!result.pinned[c] && d < best) {
-          best = d;
-          v = c;
-        }
-      }
+      const int v = nearest_free_corner(w, options.reach * size).first;
       if (v < 0) {
         if (options.stretch_rings > 0 && stretch(w, limit)) ++snapped;
         continue;
