@@ -496,18 +496,21 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     return best;
   };
   auto farthest = [&]() { return distance.empty() ? 0.0 : *std::max_element(distance.begin(), distance.end()); };
-  // How far v's quads stray from the model: the largest distance of their edge midpoints and of
-  // the centres of their two triangles (split as the measure splits them).
+  // How far quad q strays from the model: the largest distance of its edge midpoints and of the
+  // centres of its two triangles (split as the measure splits them); off_model: of several quads.
+  auto quad_off = [&](int q) {
+    Eigen::Vector3d p[4];
+    for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
+    const auto t = quad_triangle_corners(mesh, q);
+    const Eigen::Vector3d samples[6] = {(p[0] + p[1]) / 2, (p[1] + p[2]) / 2, (p[2] + p[3]) / 2, (p[3] + p[0]) / 2,
+                                        (p[t[0][0]] + p[t[0][1]] + p[t[0][2]]) / 3, (p[t[1][0]] + p[t[1][1]] + p[t[1][2]]) / 3};
+    double off = 0;
+    for (const Eigen::Vector3d& y : samples) off = std::max(off, surface.closest(y, quad_hit[q]).distance);
+    return off;
+  };
   auto off_model = [&](const std::vector<int>& quads) {
     double off = 0;
-    for (int q : quads) {
-      Eigen::Vector3d p[4];
-      for (int k = 0; k < 4; ++k) p[k] = mesh.V.row(mesh.Q(q, k));
-      const auto t = quad_triangle_corners(mesh, q);
-      const Eigen::Vector3d samples[6] = {(p[0] + p[1]) / 2, (p[1] + p[2]) / 2, (p[2] + p[3]) / 2, (p[3] + p[0]) / 2,
-                                          (p[t[0][0]] + p[t[0][1]] + p[t[0][2]]) / 3, (p[t[1][0]] + p[t[1][1]] + p[t[1][2]]) / 3};
-      for (const Eigen::Vector3d& y : samples) off = std::max(off, surface.closest(y, quad_hit[q]).distance);
-    }
+    for (int q : quads) off = std::max(off, quad_off(q));
     return off;
   };
   // Whether the model points owned by `quads` (all moved) stay within max(limit, their distance)
@@ -573,6 +576,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   std::vector<Eigen::Vector3d> region_old;
   std::vector<int> touched_state;
   std::vector<SurfaceHit> touched_hit;
+  std::vector<double> touched_off;
   auto stretch = [&](int w, double limit) {
     const Eigen::Vector3d& x = points[w];
     const auto [v, best] = nearest_free_corner(w, INFINITY);
@@ -598,7 +602,8 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     for (int u : region) touched.insert(touched.end(), around[u].begin(), around[u].end());
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-    const double off_before = off_model(touched);
+    touched_off.clear();
+    for (int q : touched) touched_off.push_back(quad_off(q));
     region_old.clear();
     for (size_t i = 0; i < region.size(); ++i) {
       region_old.push_back(mesh.V.row(region[i]));
@@ -634,7 +639,12 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
       touched_state.push_back(guard.state(q, touched_hit.back(), size));
       if (quad_state[q] & ~touched_state.back()) return undo();
     }
-    if (off_model(touched) > std::max(tolerance, off_before) || !still_covered(touched, limit)) return undo();
+    // Each quad moved stays within the tolerance of the model, no farther off than it was, or
+    // within half the miss being mended (the local distance falls at least by half).
+    const double allowed = std::max(tolerance, distance[w] / 2);
+    for (size_t i = 0; i < touched.size(); ++i)
+      if (quad_off(touched[i]) > std::max(allowed, touched_off[i])) return undo();
+    if (!still_covered(touched, limit)) return undo();
     for (size_t i = 0; i < touched.size(); ++i) {
       quad_state[touched[i]] = touched_state[i];
       quad_hit[touched[i]] = touched_hit[i];

@@ -112,9 +112,9 @@ struct QuadFitOptions {
   // A point farther than `reach` from every corner of its quad (a tip the map squeezed, the quads
   // round it small and short of it): the nearest corner is pulled onto it with the vertices
   // within up to this many rings following by less and less, so the pull spreads over a few
-  // quads (no corner-angle limit: a tip's corner is sharp; the guard, the covering and the bound
-  // on the quads' distance off the model still hold, over all the quads moved). 0: such points
-  // are left.
+  // quads (no corner-angle limit: a tip's corner is sharp; the guard and the covering still hold
+  // over all the quads moved, and each of them ends within the tolerance of the model, within
+  // half the point's distance, or no farther off than before). 0: such points are left.
   int stretch_rings = 8;
 };
 

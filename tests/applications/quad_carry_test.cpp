@@ -323,8 +323,9 @@ TEST(QuadCarry, RefinementReachesIntoAHorn) {
   EXPECT_LE(refined.quality.max_distance_to_surface, 1e-9 * refined.quality.diagonal);
 }
 
-// Without refinement, the fit's pulls with rings following reach into the horn that the single
-// pulls leave: the quads come nearer the model, with nothing flipped.
+// Without refinement, the fit's pulls with rings following reach up the horn that the single
+// pulls leave: the quads come nearer the model (measured 0.83 % -> 0.61 % of the diagonal), with
+// nothing flipped.
 TEST(QuadCarry, HornIsReachedByTheFitsStretch) {
   QuadRemeshOptions options = horn_options(1500, 0);
   const QuadRemeshResult single = remesh_horn(options);
