@@ -570,8 +570,9 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   // within R rings of it follow, ring r by (1 - r / (R + 1)) of the pull, each placed on its own
   // sheet (closest_on_sheet), R the pull over the corner's mean edge length (at most
   // stretch_rings), so the quads between stretch by about one edge each instead of one quad by
-  // the whole pull. Taken when no quad round a moved vertex loses a bit of its guard state and the
-  // model points stay covered (as for a single pull); the corner is pinned.
+  // the whole pull. Taken when no quad round a moved vertex loses a bit of its guard state, none
+  // ends farther off the model than the tolerance, half the point's distance and its own distance
+  // before, and the model points stay covered (as for a single pull); the corner is pinned.
   std::vector<int> ring_of(nv, -1), slot(nv, -1), region, touched;
   std::vector<Eigen::Vector3d> region_old;
   std::vector<int> touched_state;
