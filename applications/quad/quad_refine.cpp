@@ -69,7 +69,9 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
   // cell apart).
   const SurfaceSamples sampled = sample_surface(surface, cell_size / 4);
   const std::vector<Eigen::Vector3d>& samples = sampled.points;
-  // Points of the quads, on M and on P: centres, and midpoints of edges (each once).
+  // Points of the quads, on M and on P: centres, the centroids of the two triangles the measure
+  // splits each into (a quad the fit stretched bends: its centre lies on neither; armadillo and
+  // spool read 0.44 % here and measured 0.517 % before), and midpoints of edges (each once).
   std::vector<Eigen::Vector3d> quad_points, quad_points_on_p;
   for (int q = 0; q < quads.num_quads(); ++q) {
     Eigen::Vector3d on_model = Eigen::Vector3d::Zero(), on_p = Eigen::Vector3d::Zero();
@@ -79,6 +81,15 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
     }
     quad_points.push_back(on_model);
     quad_points_on_p.push_back(on_p);
+    for (const auto& t : quad_triangle_corners(quads, q)) {
+      Eigen::Vector3d m = Eigen::Vector3d::Zero(), p = Eigen::Vector3d::Zero();
+      for (int i : t) {
+        m += quads.V.row(quads.Q(q, i)).transpose() / 3;
+        p += grid.mesh.V.row(grid.mesh.Q(q, i)).transpose() / 3;
+      }
+      quad_points.push_back(m);
+      quad_points_on_p.push_back(p);
+    }
     for (int i = 0; i < 4; ++i) {
       const int u = quads.Q(q, i), w = quads.Q(q, (i + 1) % 4);
       if (u > w) continue;

@@ -87,8 +87,9 @@ class PreimageLocator {
 //             farther than `distance` from the quads (two triangles each) — M's vertices, the
 //             centroids of its triangles longer than cell_size / 4 and points along its edges
 //             longer than that, at most cell_size / 4 apart (a coarse CAD mesh is missed between
-//             its vertices, along its creases) — and the points on P of quad centres and quad edge
-//             midpoints farther than `distance` from M (quads bridging a concave crease)
+//             its vertices, along its creases) — and the points on P of quad centres, of the
+//             centroids of each quad's two triangles (split as the measure splits it) and of quad
+//             edge midpoints farther than `distance` from M (quads bridging a concave crease)
 //   distances their distances
 //   farthest  the largest of both distances: exact when above `distance`; when every point is
 //             within it, perhaps a little over the true largest (a point of M may be measured by
