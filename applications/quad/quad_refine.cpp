@@ -70,8 +70,8 @@ QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const
   const SurfaceSamples sampled = sample_surface(surface, cell_size / 4);
   const std::vector<Eigen::Vector3d>& samples = sampled.points;
   // Points of the quads, on M and on P: centres, the centroids of the two triangles the measure
-  // splits each into (a quad the fit stretched bends: its centre lies on neither; armadillo and
-  // spool read 0.44 % here and measured 0.517 % before), and midpoints of edges (each once).
+  // splits each into (a quad the fit stretched bends: its centre lies on neither; without them
+  // armadillo and spool ended 0.517 % off the model), and midpoints of edges (each once).
   std::vector<Eigen::Vector3d> quad_points, quad_points_on_p;
   for (int q = 0; q < quads.num_quads(); ++q) {
     Eigen::Vector3d on_model = Eigen::Vector3d::Zero(), on_p = Eigen::Vector3d::Zero();
