@@ -90,8 +90,8 @@ TEST(QuadCli, MapBuiltInMemory) {
 
 // Quads that fall short (a flipped quad, or more than 1 % of the diagonal from the model) try the
 // orientation search's next candidates, and the best are written: elephant at 3000 quads without
-// refinement, whose winner's quads miss the model by 0.75 % of the diagonal (with refinement they
-// meet the bound at once). The kept try ranks first (flipped + degenerate, then within
+// refinement, whose winner's quads have a flipped quad and miss the model by 1.4 % of the
+// diagonal (with refinement they meet the bound at once: 0.35 %). The kept try ranks first (flipped + degenerate, then within
 // 0.5 %, then the distance); the file and the report are its.
 TEST(QuadCli, QuadsThatFallShortTryTheNextOrientations) {
   const std::string dir = test::temp_dir("quad-retry");
