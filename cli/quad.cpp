@@ -456,6 +456,15 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                             {"flipped_after", result.untangling.flipped_after},
                             {"moves", result.untangling.moves}};
     report["quality"] = quality_json(q);
+    // Where the flipped and degenerate quads are (the first 20), to find them in a viewer.
+    nlohmann::json bad = nlohmann::json::array();
+    for (int b : bad_quads(result.mesh, *projector, remesh.quality)) {
+      if (bad.size() == 20) break;
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) centre += result.mesh.V.row(result.mesh.Q(b, k)).transpose() / 4;
+      bad.push_back({{"quad", b}, {"centre", {centre.x(), centre.y(), centre.z()}}});
+    }
+    report["quality"]["bad_quads"] = bad;
     report["warnings"] = warnings;
     report["seconds"] = seconds;
     report["output"] = options.output;

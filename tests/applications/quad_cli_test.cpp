@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <string>
 #include <tuple>
 
@@ -132,6 +133,19 @@ TEST(QuadCli, QuadsThatFallShortTryTheNextOrientations) {
   EXPECT_EQ(report["quality"]["quads"], tried[kept]["quads"]);
   EXPECT_EQ(report["quality"]["flipped_quads"], tried[kept]["flipped"]);
   EXPECT_DOUBLE_EQ(report["quality"]["hausdorff_percent_diagonal"].get<double>(), tried[kept]["hausdorff_percent"].get<double>());
+  // The bad quads are listed by face index in the file, with their centres.
+  const nlohmann::json& bad = report["quality"]["bad_quads"];
+  const int flipped = report["quality"]["flipped_quads"].get<int>(), degenerate = report["quality"]["degenerate_quads"].get<int>();
+  EXPECT_LE(static_cast<int>(bad.size()), std::min(20, flipped + degenerate));
+  EXPECT_GE(static_cast<int>(bad.size()), std::min(20, std::max(flipped, degenerate)));
+  for (const nlohmann::json& b : bad) {
+    const int q = b["quad"].get<int>();
+    ASSERT_GE(q, 0);
+    ASSERT_LT(q, quads.num_quads());
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) centre += quads.V.row(quads.Q(q, k)).transpose() / 4;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(b["centre"][i].get<double>(), centre[i], 1e-5) << q;
+  }
   const QuadTopology t = quad_topology(quads);
   EXPECT_TRUE(t.closed_manifold());
   EXPECT_EQ(t.genus(), 3);
