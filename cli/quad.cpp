@@ -454,7 +454,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                          {"relaxation_sweeps", result.refitting.sweeps}};
     report["untangling"] = {{"flipped_before", result.untangling.flipped_before},
                             {"flipped_after", result.untangling.flipped_after},
-                            {"moves", result.untangling.moves}};
+                            {"moves", result.untangling.moves},
+                            {"patches", result.untangling.patches}};
     report["quality"] = quality_json(q);
     // Where the flipped and degenerate quads are (the first 20), to find them in a viewer.
     nlohmann::json bad = nlohmann::json::array();

@@ -164,10 +164,11 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       begin = std::chrono::steady_clock::now();
       pass.untangling = untangle_quads(pass.mesh, model, options.untangle, pass.fitting.pinned);
       if (pass.untangling.flipped_after > 0 && !pass.fitting.pinned.empty()) {
-        const int flipped_before = pass.untangling.flipped_before, moves = pass.untangling.moves;
+        const int flipped_before = pass.untangling.flipped_before, moves = pass.untangling.moves, patches = pass.untangling.patches;
         pass.untangling = untangle_quads(pass.untangling.mesh, model, options.untangle);
         pass.untangling.flipped_before = flipped_before;
         pass.untangling.moves += moves;
+        pass.untangling.patches += patches;
       }
       pass.mesh = std::move(pass.untangling.mesh);
       pass.untangling.mesh = QuadMesh{};
@@ -175,7 +176,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       if (pass.untangling.flipped_before > 0)
         say("untangle", std::to_string(pass.untangling.flipped_before) + " flipped quads -> " +
                             std::to_string(pass.untangling.flipped_after) + ", " + std::to_string(pass.untangling.moves) +
-                            " vertex moves");
+                            " vertex moves, " + std::to_string(pass.untangling.patches) + " patches laid out again");
     }
   };
   run_pass(result, false, nullptr);
@@ -470,6 +471,27 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
                          std::to_string(result.grid.mesh.num_quads()) + " quads, farthest miss " +
                          format("%.3f -> %.3f %% of the diagonal", 100 * result.refine_miss_before / diagonal,
                                 100 * result.refine_miss_after / diagonal));
+  }
+  // Quads the last steps left flipped (a kept round's relaxation, pinned corners): untangled once
+  // more with every vertex free, taken if that leaves fewer flipped or degenerate quads.
+  if (options.untangle.passes > 0) {
+    QuadQualityOptions topology_only = options.quality;
+    topology_only.hausdorff = false;
+    const std::vector<int> bad_before = bad_quads(result.mesh, model, topology_only);
+    if (!bad_before.empty()) {
+      const auto begin = std::chrono::steady_clock::now();
+      QuadUntangleResult last = untangle_quads(result.mesh, model, options.untangle);
+      const size_t bad_after = bad_quads(last.mesh, model, topology_only).size();
+      if (bad_after < bad_before.size()) {
+        report("untangle", "the result's " + std::to_string(bad_before.size()) + " flipped or degenerate quads -> " +
+                               std::to_string(bad_after) + " with every vertex free");
+        result.mesh = std::move(last.mesh);
+        result.untangling.moves += last.moves;
+        result.untangling.patches += last.patches;
+        result.untangling.flipped_after = last.flipped_after;
+      }
+      result.seconds_untangle += since(begin);
+    }
   }
   const PolycubeGrid& grid = result.grid;
 

@@ -1,5 +1,6 @@
 #include "applications/quad/quad_smooth.h"
 
+#include "applications/quad/quad_guard.h"
 #include "applications/quad/quad_quality.h"
 
 #include "polycube/closest_point.h"
@@ -25,27 +26,9 @@ namespace {
 
 using Complex = std::complex<double>;
 
-// A move's closest point is taken when the surface normal there is within about 70° of the
-// normal at the vertex.
-constexpr double kSameSheet = 0.3;
 constexpr double kPi = 3.14159265358979323846;
 // No move shortens an edge below this times the mean quad size.
 constexpr double kShortestEdge = 0.02;
-// Edges up to this times the mean quad size count as collapsed (a map sent both ends to one
-// point): their corners are free to move.
-constexpr double kCollapsedEdge = 1e-3;
-
-// Square root of the mean quad area (areas by the diagonals' cross product).
-double mean_quad_size(const QuadMesh& mesh) {
-  if (mesh.num_quads() == 0) return 0;
-  double area = 0;
-  for (int q = 0; q < mesh.num_quads(); ++q) {
-    const Eigen::Vector3d d1 = mesh.V.row(mesh.Q(q, 2)) - mesh.V.row(mesh.Q(q, 0));
-    const Eigen::Vector3d d2 = mesh.V.row(mesh.Q(q, 3)) - mesh.V.row(mesh.Q(q, 1));
-    area += d1.cross(d2).norm() / 2;
-  }
-  return std::sqrt(area / mesh.num_quads());
-}
 
 // Greedy colouring of the movable vertices such that two vertices of one colour share no quad.
 std::vector<std::vector<int>> quad_star_colours(const Eigen::MatrixX4i& Q, const std::vector<std::vector<int>>& around,
@@ -72,44 +55,18 @@ std::vector<std::vector<int>> quad_star_colours(const Eigen::MatrixX4i& Q, const
   return colours;
 }
 
-// What the moves of a vertex may not spoil, per quad: bit k is set when corner k turns with the
-// quad's surface normal (as measure_quads counts inverted corners), bit 4 when the quad (its
-// diagonals) does (flipped quads). A move is refused when it clears a bit of one of the vertex's
-// quads.
-class QuadGuard {
- public:
-  QuadGuard(const QuadMesh& mesh, const SurfaceProjector& surface) : mesh_(mesh), surface_(surface) {}
-
-  // centre: in, the search hint for the quad centre's closest point (face -1: none); out, that
-  // point. size: the mean quad size (corners with an edge below kCollapsedEdge of it are free).
-  // on_sheet: the centre's closest point on the hint's sheet (SurfaceProjector::closest_on_sheet,
-  // fast) instead of on the whole surface (as measure_quads takes it).
-  int state(int q, SurfaceHit& centre, double size, bool on_sheet = false) const {
-    int bits = 0;
-    Eigen::Vector3d p[4];
-    for (int k = 0; k < 4; ++k) p[k] = mesh_.V.row(mesh_.Q(q, k));
-    const Eigen::Vector3d middle = (p[0] + p[1] + p[2] + p[3]) / 4;
-    centre = centre.face < 0 ? surface_.closest(middle)
-             : on_sheet        ? surface_.closest_on_sheet(middle, centre)
-                               : surface_.closest(middle, centre);
-    const Eigen::Vector3d n = quad_surface_normal(surface_, centre);
-    // A corner with an edge of (almost) no length has no meaningful turn: it is not held, so
-    // vertices a map collapsed onto one point can move apart.
-    const double shortest = kCollapsedEdge * size;
-    for (int k = 0; k < 4; ++k)
-      if ((p[(k + 1) % 4] - p[k]).norm() > shortest && (p[(k + 3) % 4] - p[k]).norm() > shortest &&
-          (p[(k + 1) % 4] - p[k]).cross(p[(k + 3) % 4] - p[k]).dot(n) > 0)
-        bits |= 1 << k;
-    if ((p[2] - p[0]).cross(p[3] - p[1]).dot(n) > 0) bits |= 16;
-    return bits;
-  }
-
- private:
-  const QuadMesh& mesh_;
-  const SurfaceProjector& surface_;
-};
-
 }  // namespace
+
+double mean_quad_size(const QuadMesh& mesh) {
+  if (mesh.num_quads() == 0) return 0;
+  double area = 0;
+  for (int q = 0; q < mesh.num_quads(); ++q) {
+    const Eigen::Vector3d d1 = mesh.V.row(mesh.Q(q, 2)) - mesh.V.row(mesh.Q(q, 0));
+    const Eigen::Vector3d d2 = mesh.V.row(mesh.Q(q, 3)) - mesh.V.row(mesh.Q(q, 1));
+    area += d1.cross(d2).norm() / 2;
+  }
+  return std::sqrt(area / mesh.num_quads());
+}
 
 QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadSmoothOptions& options,
                               const std::vector<char>& pinned) {
@@ -732,123 +689,6 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     measure_all();
   }
   result.farthest_after = farthest();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return result;
-}
-
-QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadUntangleOptions& options,
-                                  const std::vector<char>& pinned) {
-  const auto start = std::chrono::steady_clock::now();
-  if (options.passes < 0 || options.rings < 0)
-    throw std::invalid_argument("untangling passes and rings must be >= 0, got " + std::to_string(options.passes) + " and " +
-                                std::to_string(options.rings));
-  if (!pinned.empty() && static_cast<int>(pinned.size()) != quads.num_vertices())
-    throw std::invalid_argument("untangling: " + std::to_string(pinned.size()) + " pinned flags for " +
-                                std::to_string(quads.num_vertices()) + " vertices");
-  QuadUntangleResult result;
-  result.mesh = quads;
-  QuadMesh& mesh = result.mesh;
-  const int nv = mesh.num_vertices(), nq = mesh.num_quads();
-  const std::vector<std::vector<int>> neighbours = vertex_neighbours(mesh.Q, nv);
-  const std::vector<std::vector<int>> around = vertex_quads(mesh.Q, nv);
-  const double size = mean_quad_size(mesh);
-  const QuadGuard guard(mesh, surface);
-  // Per quad: flipped (its diagonals against the surface) and inverted corners, as measure_quads
-  // counts them (kCollapsedEdge aside: a corner with a collapsed edge counts as inverted here).
-  const auto badness = [&](int q) {
-    SurfaceHit centre;
-    const int bits = guard.state(q, centre, size);
-    int inverted = 0;
-    for (int k = 0; k < 4; ++k) inverted += !(bits & (1 << k));
-    return std::make_pair(bits & 16 ? 0 : 1, inverted);
-  };
-  std::vector<std::pair<int, int>> state(nq);
-  for (int q = 0; q < nq; ++q) state[q] = badness(q);
-  const auto count_flipped = [&]() {
-    int n = 0;
-    for (const auto& s : state) n += s.first;
-    return n;
-  };
-  result.flipped_before = result.flipped_after = count_flipped();
-  const auto sum = [](const std::vector<std::pair<int, int>>& of) {
-    std::pair<int, int> total{0, 0};
-    for (const auto& [flipped, inverted] : of) {
-      total.first += flipped;
-      total.second += inverted;
-    }
-    return total;
-  };
-  std::vector<std::pair<int, int>> before, after;
-  std::vector<Eigen::Vector3d> targets;
-  // Tries to move v; true when it moved.
-  const auto try_vertex = [&](int v) {
-    if ((!pinned.empty() && pinned[v]) || neighbours[v].empty()) return false;
-    before.clear();
-    for (int q : around[v]) before.push_back(state[q]);
-    const std::pair<int, int> was = sum(before);
-    if (was.first == 0 && was.second == 0) return false;
-    const Eigen::Vector3d p = mesh.V.row(v);
-    const SurfaceHit here = surface.closest(p);
-    // The mean of the edge neighbours, of the quads' centres, of the parallelogram corners
-    // a + c - b (a, b, c: the quad's other corners in order, b opposite v) and each flipped quad's.
-    targets.assign(3, Eigen::Vector3d::Zero());
-    for (int w : neighbours[v]) targets[0] += mesh.V.row(w).transpose() / static_cast<double>(neighbours[v].size());
-    for (int q : around[v]) {
-      int c = 0;
-      while (mesh.Q(q, c) != v) ++c;
-      const Eigen::Vector3d parallelogram = mesh.V.row(mesh.Q(q, (c + 1) % 4)) + mesh.V.row(mesh.Q(q, (c + 3) % 4)) -
-                                            mesh.V.row(mesh.Q(q, (c + 2) % 4));
-      targets[1] += (p + mesh.V.row(mesh.Q(q, (c + 1) % 4)).transpose() + mesh.V.row(mesh.Q(q, (c + 2) % 4)).transpose() +
-                     mesh.V.row(mesh.Q(q, (c + 3) % 4)).transpose()) /
-                    (4.0 * around[v].size());
-      targets[2] += parallelogram / static_cast<double>(around[v].size());
-      if (state[q].first > 0) targets.push_back(parallelogram);
-    }
-    for (const Eigen::Vector3d& target : targets)
-      for (double t : {1.0, 0.5, 0.25}) {
-        const SurfaceHit hit = surface.closest(p + t * (target - p), here);
-        if (hit.normal.dot(here.normal) < kSameSheet) continue;
-        mesh.V.row(v) = hit.point.transpose();
-        after.clear();
-        for (int q : around[v]) after.push_back(badness(q));
-        if (sum(after) < was) {
-          for (size_t i = 0; i < around[v].size(); ++i) state[around[v][i]] = after[i];
-          ++result.moves;
-          return true;
-        }
-        mesh.V.row(v) = p.transpose();
-      }
-    return false;
-  };
-  for (int pass = 0; pass < options.passes; ++pass) {
-    // The vertices of the bad quads and, ring by ring, round them, while a ring gains nothing.
-    std::vector<char> in(nv, 0);
-    std::vector<int> front;
-    for (int q = 0; q < nq; ++q)
-      if (state[q].first > 0)
-        for (int k = 0; k < 4; ++k)
-          if (!in[mesh.Q(q, k)]) {
-            in[mesh.Q(q, k)] = 1;
-            front.push_back(mesh.Q(q, k));
-          }
-    if (front.empty()) break;
-    bool moved = false;
-    for (int ring = 0; ring <= options.rings && !moved; ++ring) {
-      if (ring > 0) {
-        std::vector<int> next;
-        for (int v : front)
-          for (int w : neighbours[v])
-            if (!in[w]) {
-              in[w] = 1;
-              next.push_back(w);
-            }
-        front.insert(front.end(), next.begin(), next.end());
-      }
-      for (int v : front) moved = try_vertex(v) || moved;
-    }
-    if (!moved) break;
-  }
-  result.flipped_after = count_flipped();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -141,30 +141,42 @@ struct QuadFitResult {
 QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadFitOptions& options = {},
                         const std::vector<char>& pinned = {});
 
-// Untangling the quads a map folded: vertices of flipped quads (and, when that is not enough,
-// within `rings` rings of quads of them) move, one at a time, towards the mean of their edge
-// neighbours, then the mean of their quads' centres (full, half or a quarter of the way, on the
-// surface near the vertex: a closest point whose normal is within about 70° of the vertex's). A
-// move is taken only if, over the vertex's quads, it lowers (flipped quads, inverted corners) in
-// that order, both judged as measure_quads judges them (a corner with a collapsed edge counts as
-// inverted); so the flipped quads in all never grow. Passes repeat while they gain.
+// Untangling the quads a map folded: vertices of bad quads (flipped, or with an edge or the
+// area collapsed below 1e-3 of the mean quad size, or its square) and, when that is not enough, those within `rings` rings of
+// quads of them move, one at a time, towards the mean of their edge neighbours, then the mean of
+// their quads' centres (full, half or a quarter of the way, on the surface near the vertex: a
+// closest point whose normal is within about 70° of the vertex's). A move is taken only if, over
+// the vertex's quads, it lowers (bad quads, inverted corners) in that order, judged as
+// measure_quads judges them (a corner with a collapsed edge counts as inverted); so the bad
+// quads in all never grow. Passes repeat while they gain.
+// Quads still bad after that: a patch round each, the quads within r rings of it or those
+// reached from it with centres within r mean quad sizes (r = 1, 2, ..., patch_rings, until one
+// gains; closed over where it touches itself and over its holes), laid out again by Tutte's
+// embedding in the plane across the surface's mean normal under it, its boundary and pinned
+// vertices kept, its inner vertices placed on the surface where they project onto their places
+// (refused when the patch is no disk, the surface under it turns more than about 70° from the
+// plane, or its boundary or a quad turns over in the plane); taken by the same rule as a vertex
+// move, over the patch's quads.
 struct QuadUntangleOptions {
   int passes = 10;
   int rings = 2;
+  int patch_rings = 6;  // 0: no patches
 };
 
 //   mesh           the quads (same connectivity)
 //   moves          vertex moves taken
+//   patches        patches laid out again
 //   flipped_before, flipped_after  flipped quads as measure_quads counts them
 struct QuadUntangleResult {
   QuadMesh mesh;
   int moves = 0;
+  int patches = 0;  // patches laid out again
   int flipped_before = 0, flipped_after = 0;
   double seconds = 0;
 };
 
 // pinned (empty, or one flag per vertex): vertices that do not move.
-// Throws std::invalid_argument for negative passes or rings, or pinned flags of the wrong size.
+// Throws std::invalid_argument for negative passes, rings or patch_rings, or pinned flags of the wrong size.
 QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadUntangleOptions& options = {},
                                   const std::vector<char>& pinned = {});
 

@@ -147,10 +147,84 @@ TEST(QuadUntangle, UnfoldsAFoldedVertex) {
 
   QuadUntangleOptions none;
   none.passes = 0;
+  none.patch_rings = 0;
   EXPECT_EQ(untangle_quads(grid, top, none).mesh.V, grid.V);
   none.passes = -1;
   EXPECT_THROW(untangle_quads(grid, top, none), std::invalid_argument);
   EXPECT_THROW(untangle_quads(grid, top, {}, std::vector<char>(3, 0)), std::invalid_argument);
+}
+
+// A 4 x 4 grid on the box's top face with its middle vertex on its neighbour (a map sent both to
+// one point): two quads are degenerate, none flipped. The untangling moves them apart.
+TEST(QuadUntangle, SeparatesCollapsedVertices) {
+  const TriMesh box = thin_box(0.1);
+  const SurfaceProjector top(box);
+  QuadMesh grid;
+  grid.V.resize(25, 3);
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) grid.V.row(5 * i + j) << 0.1 + 0.2 * i, 0.1 + 0.2 * j, 0.1;
+  grid.Q.resize(16, 4);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) grid.Q.row(4 * i + j) << 5 * i + j, 5 * (i + 1) + j, 5 * (i + 1) + j + 1, 5 * i + j + 1;
+  grid.V.row(12) = grid.V.row(13);
+  QuadQualityOptions no_distance;
+  no_distance.hausdorff = false;
+  const QuadQuality before = measure_quads(grid, top, {}, no_distance);
+  ASSERT_GT(before.degenerate_quads, 0);
+  ASSERT_EQ(before.flipped_quads, 0);
+  const QuadUntangleResult r = untangle_quads(grid, top);
+  const QuadQuality after = measure_quads(r.mesh, top, {}, no_distance);
+  EXPECT_EQ(after.degenerate_quads, 0);
+  EXPECT_EQ(after.flipped_quads, 0);
+  EXPECT_EQ(after.inverted_corners, 0);
+  EXPECT_GT(r.moves, 0);
+}
+
+// An 8 x 8 grid on the box's top face whose inner 5 x 5 vertices are mirrored across the diagonal:
+// the quads among them turn over whole (every corner inverted), and moving one vertex at a time
+// cannot turn them back. Laying out the patch round them again (Tutte's embedding) does: no
+// flipped quad, every vertex on the face, the boundary of the patch where it was.
+TEST(QuadUntangle, LaysOutAMirroredPatchAgain) {
+  const TriMesh box = thin_box(0.1);
+  const SurfaceProjector top(box);
+  QuadMesh grid;
+  const int n = 9;
+  grid.V.resize(n * n, 3);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) grid.V.row(n * i + j) << 0.1 + 0.1 * i, 0.1 + 0.1 * j, 0.1;
+  grid.Q.resize((n - 1) * (n - 1), 4);
+  for (int i = 0; i + 1 < n; ++i)
+    for (int j = 0; j + 1 < n; ++j)
+      grid.Q.row((n - 1) * i + j) << n * i + j, n * (i + 1) + j, n * (i + 1) + j + 1, n * i + j + 1;
+  const QuadMesh straight = grid;
+  for (int i = 2; i <= 6; ++i)
+    for (int j = 2; j <= 6; ++j) grid.V.row(n * i + j) = straight.V.row(n * j + i);
+  QuadQualityOptions no_distance;
+  no_distance.hausdorff = false;
+  const int mirrored = measure_quads(grid, top, {}, no_distance).flipped_quads;
+  ASSERT_GT(mirrored, 0) << "the test needs flipped quads";
+
+  QuadUntangleOptions vertex_moves;
+  vertex_moves.patch_rings = 0;
+  const QuadUntangleResult moves = untangle_quads(grid, top, vertex_moves);
+  ASSERT_GT(moves.flipped_after, 0) << "vertex moves alone mend it: the test shows nothing";
+  EXPECT_EQ(moves.patches, 0);
+
+  const QuadUntangleResult r = untangle_quads(grid, top);
+  EXPECT_EQ(r.flipped_after, 0);
+  EXPECT_GT(r.patches, 0);
+  const QuadQuality after = measure_quads(r.mesh, top, {}, no_distance);
+  EXPECT_EQ(after.flipped_quads, 0);
+  EXPECT_EQ(after.degenerate_quads, 0);
+  EXPECT_EQ(r.mesh.Q, grid.Q);
+  for (int v = 0; v < n * n; ++v) {
+    EXPECT_NEAR(r.mesh.V(v, 2), 0.1, 1e-12) << "on the top face";
+    const int i = v / n, j = v % n;
+    if (i == 0 || j == 0 || i == n - 1 || j == n - 1) EXPECT_EQ(r.mesh.V.row(v), grid.V.row(v)) << "the grid's rim stays";
+  }
+  QuadUntangleOptions bad;
+  bad.patch_rings = -1;
+  EXPECT_THROW(untangle_quads(grid, top, bad), std::invalid_argument);
 }
 
 // On a real tangled map (anchor's unrelaxed quads) the untangling lowers the flipped quads
