@@ -220,7 +220,9 @@ TEST(QuadUntangle, LaysOutAMirroredPatchAgain) {
   for (int v = 0; v < n * n; ++v) {
     EXPECT_NEAR(r.mesh.V(v, 2), 0.1, 1e-12) << "on the top face";
     const int i = v / n, j = v % n;
-    if (i == 0 || j == 0 || i == n - 1 || j == n - 1) EXPECT_EQ(r.mesh.V.row(v), grid.V.row(v)) << "the grid's rim stays";
+    if (i == 0 || j == 0 || i == n - 1 || j == n - 1) {
+      EXPECT_EQ(r.mesh.V.row(v), grid.V.row(v)) << "the grid's rim stays";
+    }
   }
   QuadUntangleOptions bad;
   bad.patch_rings = -1;
