@@ -52,6 +52,9 @@ struct QuadCommandOptions {
   // Quads that still fall short are tried once more with d_a divided by this (as `map` does; a
   // try with more than refine_bound_growth × target_faces quads is not kept then); 1: never.
   double finer_contours = 3;
+  // Still short after that: once more with thin parts kept (PolycubeOptions::feature_distance,
+  // fraction of the largest bounding-box side); 0: never.
+  double thin_parts = 0.015;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -233,6 +236,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     report["parameters"]["da"] = options.polycube.da;
     report["parameters"]["align"] = options.align;
     report["parameters"]["finer_contours"] = options.finer_contours;
+    report["parameters"]["thin_parts"] = options.thin_parts;
   }
   // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
   // images are turned back into the input's frame. One search's candidates become attempts.
@@ -326,27 +330,42 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     }
   };
   remesh_from(0);
-  // Still short: the search once more with finer contours, as `map` does (a thin part that d_a
-  // drops from P is squeezed by the map, and the quads carried through it cut across it).
-  if (kept->worth_retrying() && options.map_dir.empty() && options.finer_contours > 1) {
-    PolycubeOptions finer = options.polycube;
-    finer.da = options.polycube.da / options.finer_contours;
-    std::ostringstream suffix;
-    suffix << ", finer contours (d_a " << finer.da << ")";
-    progress.stage("retry", shortfall() + "all over again with d_a " + std::to_string(finer.da));
+  // Another search for quads still short, with other polycube options. A finer P's layout can
+  // need many more quads than asked (spool: 104 368 for 10 000, at 0.538 % against 0.705 %, 4
+  // minutes): such tries are capped (not kept above the growth the refinement may reach, given up
+  // when the grid alone is half as large again).
+  const auto search_again = [&](const PolycubeOptions& polycube, const std::string& key, const std::string& suffix,
+                                const std::string& what) {
+    progress.stage("retry", shortfall() + "all over again " + what);
     const size_t first = attempts.size();
     try {
-      add_attempts(finer, report["alignment"]["finer_contours"], suffix.str());
-      // A finer P's layout can need many more quads than asked (spool: 104 368 for 10 000, at
-      // 0.538 % against 0.705 %, 4 minutes): such tries are capped (not kept above the growth
-      // the refinement may reach, given up when the grid alone is half as large again).
+      add_attempts(polycube, report["alignment"][key], suffix);
       if (options.cell_size <= 0)
         for (size_t i = first; i < attempts.size(); ++i)
           attempts[i]->max_quads = static_cast<long long>(1.5 * options.refine_bound_growth * options.target_faces);
       remesh_from(first);
     } catch (const Error& e) {
-      progress.warning(std::string("finer contours: ") + e.what());
+      progress.warning(key + ": " + e.what());
     }
+  };
+  // Still short: once more with finer contours, as `map` does (a thin part that d_a drops from P
+  // is squeezed by the map, and the quads carried through it cut across it).
+  if (kept->worth_retrying() && options.map_dir.empty() && options.finer_contours > 1) {
+    PolycubeOptions finer = options.polycube;
+    finer.da = options.polycube.da / options.finer_contours;
+    std::ostringstream suffix;
+    suffix << ", finer contours (d_a " << finer.da << ")";
+    search_again(finer, "finer_contours", suffix.str(), "with d_a " + std::to_string(finer.da));
+  }
+  // Still short: once more keeping thin parts (a tail or a fin whose area is small beside its
+  // section's, so d_a drops it from P and the map squeezes it; bull: 7.25 % -> 0.39 % of the
+  // diagonal).
+  if (kept->worth_retrying() && options.map_dir.empty() && options.thin_parts > 0) {
+    PolycubeOptions thin = options.polycube;
+    thin.feature_distance = options.thin_parts;
+    std::ostringstream suffix;
+    suffix << ", thin parts kept (" << thin.feature_distance << ")";
+    search_again(thin, "thin_parts", suffix.str(), "keeping thin parts");
   }
   if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;
@@ -550,6 +569,12 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
                       "try again with d_a divided by this (not with --map); 1: never")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
+  command->add_option("--thin-parts", options->thin_parts,
+                      "When the quads still fall short after that: try again keeping thin parts (tails, fins) in the polycube "
+                      "wherever they reach farther than this fraction of the largest bounding-box side from its cells (not "
+                      "with --map); 0: never")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   command->callback([options, &global, &runner] { runner = [options, &global] { return run_quad(*options, global); }; });
 }
 

@@ -137,6 +137,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
   for (const Piece& piece : topology.sliced.pieces)
     if (piece.genus != 0) throw std::invalid_argument("build_polycube: the topology stage left a piece of positive genus");
   if (options.da <= 0) throw std::invalid_argument("build_polycube: da must be positive");
+  if (!(options.feature_distance >= 0)) throw std::invalid_argument("build_polycube: feature_distance must be >= 0");
 
   PolycubeResult result;
   result.genus = topology.genus;
@@ -166,6 +167,7 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
 
   QuadtreeOptions quadtree_options;
   quadtree_options.da = options.da;
+  quadtree_options.feature_distance = options.feature_distance;
   quadtree_options.max_level = options.max_level;
   quadtree_options.max_repair_level = options.max_repair_level;
   quadtree_options.max_leaves = options.max_plane_cells;

@@ -23,6 +23,9 @@ struct PolycubeOptions {
   // Deepest quadtree level the d_a refinement goes to (cells of 2^-level of the largest
   // bounding-box side).
   int max_level = 10;
+  // Thin parts kept (QuadtreeOptions::feature_distance; fraction of the largest bounding-box
+  // side; 0: only d_a decides).
+  double feature_distance = 0;
   // Deepest quadtree level topology repairs may subdivide to (at most kQuadGridBits = 20).
   int max_repair_level = 18;
   // About how many vertices P's mesh gets; 0: as many as the model has, at least min_vertices.

@@ -133,6 +133,7 @@ class Builder {
     return result;
   }
   const Node& node(int n) const { return nodes_[n]; }
+  int size() const { return static_cast<int>(nodes_.size()); }
   int deepest() const { return deepest_; }
   // Splits from now on are not for d_a: their leaves keep the level of the leaf they refine.
   void accuracy_done() { refining_accuracy_ = false; }
@@ -303,6 +304,35 @@ QuadtreeSection approximate_section(const CrossSections& sections, int plane, co
           to_split.push_back(n);
           break;
         }
+    }
+    if (options.feature_distance > 0) {
+      std::vector<char> split(builder.size(), 0);
+      for (int n : to_split) split[n] = 1;
+      std::vector<std::vector<int>> labelled(nf);
+      for (int n : leaves) labelled[builder.node(n).face].push_back(n);
+      for (int n : leaves) {
+        const Node& node = builder.node(n);
+        if (split[n] || node.clips.empty() || node.cell.level >= max_level || node.imposed) continue;
+        const Box box(node.cell);
+        const double side = box.x1 - box.x0;
+        if (side <= options.feature_distance) continue;
+        for (const auto& [f, a] : node.face_areas) {
+          if (f == node.face || !section.face_solid[f] || a <= 0.05 * box.area()) continue;
+          bool touches = false;
+          for (int m : labelled[f]) {
+            const Box other(builder.node(m).cell);
+            if (other.x0 <= box.x1 && box.x0 <= other.x1 && other.y0 <= box.y1 && box.y0 <= other.y1) {
+              touches = true;
+              break;
+            }
+          }
+          if (!touches || side > 4 * options.feature_distance) {
+            to_split.push_back(n);
+            ++result.feature_splits;
+            break;
+          }
+        }
+      }
     }
     if (to_split.empty()) break;
     for (int n : to_split) builder.split(n);

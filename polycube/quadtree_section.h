@@ -61,6 +61,12 @@ struct QuadtreeOptions {
   double da = 0.3;
   // Deepest level the d_a refinement subdivides to (§3.2's maximal subdivision level).
   int max_level = 10;
+  // Thin parts (0: not looked for): a leaf labelled with another face than a solid face f that
+  // covers more than a twentieth of it is split while it is wider than feature_distance (unit
+  // square units) and no leaf labelled f touches it, or wider than 4 × feature_distance when one
+  // does. A tail or a fin that d_a drops (its area is small beside its region's) keeps cells of
+  // its own where it reaches farther than about feature_distance from its region's cells.
+  double feature_distance = 0;
   // Deepest level topology repairs may subdivide to (at most kQuadGridBits).
   int max_repair_level = 18;
   // Topology repair rounds at most.
@@ -85,6 +91,7 @@ struct QuadtreeSection {
   std::vector<QuadLeaf> leaves;
   std::vector<double> region_error;
   int accuracy_splits = 0;
+  int feature_splits = 0;  // of them, for QuadtreeOptions::feature_distance
   int forced_splits = 0;
   int topology_splits = 0;
   int topology_relabels = 0;

@@ -161,6 +161,8 @@ struct QuadUntangleOptions {
   int passes = 10;
   int rings = 2;
   int patch_rings = 6;  // 0: no patches
+  // Collapsed quads count as bad (false: flipped ones only).
+  bool collapsed = true;
 };
 
 //   mesh           the quads (same connectivity)

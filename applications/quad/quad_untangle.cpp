@@ -297,6 +297,7 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     const Eigen::Vector3d d1 = mesh.V.row(mesh.Q(q, 2)) - mesh.V.row(mesh.Q(q, 0));
     const Eigen::Vector3d d2 = mesh.V.row(mesh.Q(q, 3)) - mesh.V.row(mesh.Q(q, 1));
     b.collapsed = b.collapsed || d1.cross(d2).norm() / 2 <= std::max(shortest * shortest, degenerate_area);
+    if (!options.collapsed) b.collapsed = 0;
     return b;
   };
   std::vector<Badness> state(nq);

@@ -155,7 +155,8 @@ TEST(QuadUntangle, UnfoldsAFoldedVertex) {
 }
 
 // A 4 x 4 grid on the box's top face with its middle vertex on its neighbour (a map sent both to
-// one point): two quads are degenerate, none flipped. The untangling moves them apart.
+// one point): two quads are degenerate, none flipped. The untangling moves them apart (unless told
+// to mend flipped quads only).
 TEST(QuadUntangle, SeparatesCollapsedVertices) {
   const TriMesh box = thin_box(0.1);
   const SurfaceProjector top(box);
@@ -178,6 +179,12 @@ TEST(QuadUntangle, SeparatesCollapsedVertices) {
   EXPECT_EQ(after.flipped_quads, 0);
   EXPECT_EQ(after.inverted_corners, 0);
   EXPECT_GT(r.moves, 0);
+  // Flipped quads only: nothing to do.
+  QuadUntangleOptions flipped_only;
+  flipped_only.collapsed = false;
+  const QuadUntangleResult left = untangle_quads(grid, top, flipped_only);
+  EXPECT_EQ(left.moves, 0);
+  EXPECT_EQ(left.mesh.V, grid.V);
 }
 
 // An 8 x 8 grid on the box's top face whose inner 5 x 5 vertices are mirrored across the diagonal:

@@ -59,6 +59,65 @@ TEST(QuadtreeSection, AnnulusKeepsItsHoleAndMeetsDa) {
   }
 }
 
+// A prism over a polygon star-shaped from `centre` (counter-clockwise), from z = 0 to 1.
+TriMesh prism(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& centre) {
+  const int n = static_cast<int>(polygon.size());
+  TriMesh mesh;
+  mesh.V.resize(2 * n + 2, 3);
+  for (int i = 0; i < n; ++i) {
+    mesh.V.row(i) << polygon[i].x(), polygon[i].y(), 0;
+    mesh.V.row(n + i) << polygon[i].x(), polygon[i].y(), 1;
+  }
+  mesh.V.row(2 * n) << centre.x(), centre.y(), 0;
+  mesh.V.row(2 * n + 1) << centre.x(), centre.y(), 1;
+  mesh.F.resize(4 * n, 3);
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    mesh.F.row(4 * i) << 2 * n, j, i;
+    mesh.F.row(4 * i + 1) << 2 * n + 1, n + i, n + j;
+    mesh.F.row(4 * i + 2) << i, j, n + j;
+    mesh.F.row(4 * i + 3) << i, n + j, n + i;
+  }
+  return mesh;
+}
+
+// A square with a thin arm (a tail: 2 % of the section's area) cut across: d_a alone drops the
+// arm, the region's area error being small; with feature_distance the arm keeps cells of its own
+// along most of its length, and the topology still holds.
+TEST(QuadtreeSection, FeatureDistanceKeepsAThinArm) {
+  const std::vector<Eigen::Vector2d> polygon = {{0, 0},         {1, 0},        {1, 0.485}, {1.8, 0.485},
+                                                {1.8, 0.515},   {1, 0.515},    {1, 1},     {0, 1}};
+  const CrossSections sections = sections_of(prism(polygon, {0.995, 0.5}), {0.5});
+  ASSERT_EQ(sections.planes[0].num_faces(), 2);
+  // The arm in unit-square units (the frame's scale is the 1.8 wide side).
+  const double x0 = 1.05 / 1.8, x1 = 1.8 / 1.8, y0 = 0.485 / 1.8, y1 = 0.515 / 1.8;
+  const auto arm_covered = [&](const QuadtreeSection& q) {
+    double covered = 0;
+    for (const QuadLeaf& leaf : q.leaves) {
+      if (leaf.face != 1) continue;
+      const double s = std::ldexp(1.0, -leaf.cell.level);
+      const double w = std::min(x1, (leaf.cell.ix + 1) * s) - std::max(x0, leaf.cell.ix * s);
+      const double h = std::min(y1, (leaf.cell.iy + 1) * s) - std::max(y0, leaf.cell.iy * s);
+      if (w > 0 && h > 0) covered += w * h;
+    }
+    return covered / ((x1 - x0) * (y1 - y0));
+  };
+  QuadtreeOptions options;
+  options.da = 0.3;
+  const QuadtreeSection plain = approximate_section(sections, 0, {}, options);
+  ASSERT_TRUE(plain.valid) << plain.problem;
+  EXPECT_LT(arm_covered(plain), 0.2);
+  EXPECT_EQ(plain.feature_splits, 0);
+  options.feature_distance = 0.02;
+  const QuadtreeSection kept = approximate_section(sections, 0, {}, options);
+  ASSERT_TRUE(kept.valid) << kept.problem;
+  expect_partition(kept.leaves);
+  std::vector<char> mark;
+  EXPECT_EQ(check_section_topology(sections.planes[0], kept.leaves, mark), "");
+  EXPECT_GT(kept.feature_splits, 0);
+  EXPECT_GT(arm_covered(kept), 0.5);
+}
+
 TEST(QuadtreeSection, SmallerDaGivesMoreCellsAndLessError) {
   const TriMesh mesh = test::make_genus_surface(3, 32);
   const CrossSections sections = sections_of(mesh, {0.01});
