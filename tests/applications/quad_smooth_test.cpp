@@ -111,18 +111,26 @@ TriMesh thin_box(double thickness) {
   return box;
 }
 
+// An n x n grid of quads on the top face of thin_box(0.1), its vertex (i, j) (number (n + 1) i + j)
+// at (first + step i, first + step j).
+QuadMesh top_grid(int n, double first, double step) {
+  QuadMesh grid;
+  grid.V.resize((n + 1) * (n + 1), 3);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) grid.V.row((n + 1) * i + j) << first + step * i, first + step * j, 0.1;
+  grid.Q.resize(n * n, 4);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      grid.Q.row(n * i + j) << (n + 1) * i + j, (n + 1) * (i + 1) + j, (n + 1) * (i + 1) + j + 1, (n + 1) * i + j + 1;
+  return grid;
+}
+
 // A 4 x 4 grid of quads on the box's top face with its middle vertex dragged past a diagonal
 // neighbour: the quads round it fold. The untangling unfolds them all; pinned, it leaves the pin.
 TEST(QuadUntangle, UnfoldsAFoldedVertex) {
   const TriMesh box = thin_box(0.1);
   const SurfaceProjector top(box);
-  QuadMesh grid;
-  grid.V.resize(25, 3);
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j) grid.V.row(5 * i + j) << 0.1 + 0.2 * i, 0.1 + 0.2 * j, 0.1;
-  grid.Q.resize(16, 4);
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) grid.Q.row(4 * i + j) << 5 * i + j, 5 * (i + 1) + j, 5 * (i + 1) + j + 1, 5 * i + j + 1;
+  QuadMesh grid = top_grid(4, 0.1, 0.2);
   QuadQualityOptions no_distance;
   no_distance.hausdorff = false;
   ASSERT_EQ(measure_quads(grid, top, {}, no_distance).flipped_quads, 0);
@@ -160,13 +168,7 @@ TEST(QuadUntangle, UnfoldsAFoldedVertex) {
 TEST(QuadUntangle, SeparatesCollapsedVertices) {
   const TriMesh box = thin_box(0.1);
   const SurfaceProjector top(box);
-  QuadMesh grid;
-  grid.V.resize(25, 3);
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j) grid.V.row(5 * i + j) << 0.1 + 0.2 * i, 0.1 + 0.2 * j, 0.1;
-  grid.Q.resize(16, 4);
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) grid.Q.row(4 * i + j) << 5 * i + j, 5 * (i + 1) + j, 5 * (i + 1) + j + 1, 5 * i + j + 1;
+  QuadMesh grid = top_grid(4, 0.1, 0.2);
   grid.V.row(12) = grid.V.row(13);
   QuadQualityOptions no_distance;
   no_distance.hausdorff = false;
@@ -194,15 +196,8 @@ TEST(QuadUntangle, SeparatesCollapsedVertices) {
 TEST(QuadUntangle, LaysOutAMirroredPatchAgain) {
   const TriMesh box = thin_box(0.1);
   const SurfaceProjector top(box);
-  QuadMesh grid;
-  const int n = 9;
-  grid.V.resize(n * n, 3);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) grid.V.row(n * i + j) << 0.1 + 0.1 * i, 0.1 + 0.1 * j, 0.1;
-  grid.Q.resize((n - 1) * (n - 1), 4);
-  for (int i = 0; i + 1 < n; ++i)
-    for (int j = 0; j + 1 < n; ++j)
-      grid.Q.row((n - 1) * i + j) << n * i + j, n * (i + 1) + j, n * (i + 1) + j + 1, n * i + j + 1;
+  const int n = 9;  // vertices along a side
+  QuadMesh grid = top_grid(n - 1, 0.1, 0.1);
   const QuadMesh straight = grid;
   for (int i = 2; i <= 6; ++i)
     for (int j = 2; j <= 6; ++j) grid.V.row(n * i + j) = straight.V.row(n * j + i);
