@@ -153,14 +153,15 @@ TEST(QuadCli, QuadsThatFallShortTryTheNextOrientations) {
 }
 
 // Quads of every orientation still short of the bound: the search runs once more with d_a divided
-// by --finer-contours, and its quads compete with the first ones. Eight at 200 quads without
+// by --finer-contours (and, still short, with --thin-parts; off here but in the last run), and its quads compete with the first ones. Eight at 200 quads without
 // refinement is beyond 0.5 % of the diagonal on every try of the first search (at d_a 0.1 its
 // first try comes within it, 0.48 %, with more quads than the cap below, so the cap is lifted
 // here); with --finer-contours 1 the second search does not run.
 TEST(QuadCli, QuadsStillShortTryFinerContours) {
   const std::string dir = test::temp_dir("quad-finer");
   const std::string out = dir + "/eight.obj", report_path = dir + "/report.json";
-  const std::string coarse = "quad " + quoted(test::data_path("eight.off")) + " --target-faces 200 --refine 0 --refine-bound 0 --quiet";
+  const std::string base = "quad " + quoted(test::data_path("eight.off")) + " --target-faces 200 --refine 0 --refine-bound 0 --quiet";
+  const std::string coarse = base + " --thin-parts 0";
   const test::CliRun run = polycube_cli(coarse + " --refine-bound-growth 100 -o " + quoted(out) + " --report " + quoted(report_path));
   ASSERT_EQ(run.code, 0) << run.err;
   const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
@@ -215,6 +216,26 @@ TEST(QuadCli, QuadsStillShortTryFinerContours) {
   EXPECT_FALSE(first_only["alignment"].contains("finer_contours"));
   for (const nlohmann::json& t : first_only["alignment"]["tried"])
     EXPECT_EQ(t["name"].get<std::string>().find("finer contours"), std::string::npos);
+
+  // Still short: once more keeping thin parts (--thin-parts), after the first search's tries.
+  const std::string thin = dir + "/thin.json";
+  ASSERT_EQ(polycube_cli(base + " --finer-contours 1 --thin-parts 0.05 -o " + quoted(dir + "/thin.obj") + " --report " + quoted(thin)).code, 0);
+  const nlohmann::json thin_report = nlohmann::json::parse(test::read_file(thin));
+  EXPECT_DOUBLE_EQ(thin_report["parameters"]["thin_parts"].get<double>(), 0.05);
+  ASSERT_TRUE(thin_report["alignment"].contains("thin_parts"));
+  size_t plain = 0, kept_thin = 0;
+  for (const nlohmann::json& t : thin_report["alignment"]["tried"]) {
+    const bool is_thin = t["name"].get<std::string>().find(", thin parts kept (0.05)") != std::string::npos;
+    if (is_thin) {
+      ++kept_thin;
+    } else {
+      EXPECT_EQ(kept_thin, 0u) << "the first search's tries come first";
+      ++plain;
+    }
+  }
+  EXPECT_GE(plain, 1u);
+  EXPECT_GE(kept_thin, 1u);
+  EXPECT_EQ(quad_topology(read_quads(dir + "/thin.obj")).genus(), 2);
 }
 
 TEST(QuadCli, CleanErrors) {
