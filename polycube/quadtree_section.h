@@ -78,7 +78,8 @@ struct QuadtreeOptions {
 // The approximation of one plane.
 //   leaves           cover the unit square
 //   region_error     per face: area(Q_f Δ R_f) / area(R_f) for solid faces, 0 for the others
-//   *_splits         subdivisions made for d_a, because they were requested, for topology
+//   *_splits         subdivisions made for d_a (and feature_distance: feature_splits of them),
+//                    because they were requested, for topology
 //   topology_relabels  cells relabelled where subdivision could not repair the topology
 //   deepest_level    of any leaf
 //   valid            the labelling has the topology of the contours: every face of the
