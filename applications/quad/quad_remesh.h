@@ -22,6 +22,8 @@
 //           (quad_templates.h)                   transitions round them (irregular vertices off
 //                                                P's corners), the new vertices placed on the
 //                                                quads they split, relaxed round them, fitted
+//   quads   = untangle_quads(quads, M)          optional, when quads are bad: every vertex free,
+//                                                collapsed quads bad too, patches laid out again
 //   quality = measure_quads(quads, M, corners)
 #pragma once
 
