@@ -171,11 +171,10 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       untangle.patch_rings = 0;
       pass.untangling = untangle_quads(pass.mesh, model, untangle, pass.fitting.pinned);
       if (pass.untangling.flipped_after > 0 && !pass.fitting.pinned.empty()) {
-        const int flipped_before = pass.untangling.flipped_before, moves = pass.untangling.moves, patches = pass.untangling.patches;
+        const int flipped_before = pass.untangling.flipped_before, moves = pass.untangling.moves;
         pass.untangling = untangle_quads(pass.untangling.mesh, model, untangle);
         pass.untangling.flipped_before = flipped_before;
         pass.untangling.moves += moves;
-        pass.untangling.patches += patches;
       }
       pass.mesh = std::move(pass.untangling.mesh);
       pass.untangling.mesh = QuadMesh{};
@@ -183,7 +182,7 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       if (pass.untangling.flipped_before > 0)
         say("untangle", std::to_string(pass.untangling.flipped_before) + " flipped quads -> " +
                             std::to_string(pass.untangling.flipped_after) + ", " + std::to_string(pass.untangling.moves) +
-                            " vertex moves, " + std::to_string(pass.untangling.patches) + " patches laid out again");
+                            " vertex moves");
     }
   };
   run_pass(result, false, nullptr);
@@ -491,7 +490,8 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       const size_t bad_after = bad_quads(last.mesh, model, topology_only).size();
       if (bad_after < bad_before.size()) {
         report("untangle", "the result's " + std::to_string(bad_before.size()) + " flipped or degenerate quads -> " +
-                               std::to_string(bad_after) + " with every vertex free");
+                               std::to_string(bad_after) + " with every vertex free (" + std::to_string(last.patches) +
+                               " patches laid out again)");
         result.mesh = std::move(last.mesh);
         result.untangling.moves += last.moves;
         result.untangling.patches += last.patches;
