@@ -19,6 +19,15 @@ namespace polycube {
 
 namespace {
 
+// The directed edges of the patch's quads, each with how many of them have it (an edge whose
+// reverse is missing is on the patch's boundary).
+std::map<std::pair<int, int>, int> directed_edges(const Eigen::MatrixX4i& Q, const std::vector<int>& patch) {
+  std::map<std::pair<int, int>, int> edges;
+  for (int q : patch)
+    for (int k = 0; k < 4; ++k) ++edges[{Q(q, k), Q(q, (k + 1) % 4)}];
+  return edges;
+}
+
 // The quads round quad `seed`: those within `rings` rings of it (sharing a vertex, ring by ring)
 // when radius is 0, else those reached from it through shared vertices whose centres lie within
 // `radius` of its centre. Then, a few times, the quads round each vertex where the patch touches
@@ -48,9 +57,7 @@ std::vector<int> patch_round(const QuadMesh& mesh, const std::vector<std::vector
     ring_start = ring_end;
   }
   for (int round = 0; round < 6; ++round) {
-    std::map<std::pair<int, int>, int> edges;
-    for (int q : patch)
-      for (int k = 0; k < 4; ++k) ++edges[{Q(q, k), Q(q, (k + 1) % 4)}];
+    const std::map<std::pair<int, int>, int> edges = directed_edges(Q, patch);
     std::map<int, int> leaving;
     for (const auto& [edge, count] : edges)
       if (!edges.count({edge.second, edge.first})) ++leaving[edge.first];
@@ -111,9 +118,7 @@ class PatchEmbedder {
     moved.clear();
     const Eigen::MatrixX4i& Q = mesh_.Q;
     // Boundary: the directed quad edges whose reverse is not in the patch.
-    std::map<std::pair<int, int>, int> edges;
-    for (int q : patch)
-      for (int k = 0; k < 4; ++k) ++edges[{Q(q, k), Q(q, (k + 1) % 4)}];
+    const std::map<std::pair<int, int>, int> edges = directed_edges(Q, patch);
     std::map<int, int> next;  // boundary vertex -> the next one along the loop
     std::vector<int> vertices;
     for (const auto& [edge, count] : edges) {
