@@ -8,6 +8,11 @@
 //   2. otherwise a second, finer look: the faces closest to the 15 points of the barycentric grid
 //      of order 4 (corners and edge points included) and the centroid; flipped only if the
 //      chord faces away from their sum too.
+// "The faces closest to a point" are all the faces as close to it as the closest one, to within
+// the in-face tolerance: a corner on an edge of the target brings both faces there, a corner on
+// a vertex every face round it. One face picked among tied ones would depend on how a search
+// tree breaks ties, and so on the frame the meshes are given in: the audit of the files a user
+// reads (in the input frame) must be the audit the stages ran (in the frame they chose).
 // The first look alone misjudges chords whose corners lie on opposite faces of P — across a thin
 // part, or a staircase P makes of a sloped model face (rotor: a chamfer triangle whose image runs
 // from one end cap of a rod of P to the other, its normal within 10° of the model triangle's, and
@@ -27,7 +32,6 @@
 #include <Eigen/Core>
 
 #include <algorithm>
-#include <array>
 #include <vector>
 
 namespace polycube {
@@ -35,14 +39,13 @@ namespace polycube {
 // Corners within this fraction of the target's bounding-box diagonal of a face lie in it.
 inline constexpr double kInFaceTolerance = 1e-9;
 
-// The face among fm, fa, fb, fc (the faces closest to the centroid and to a, b, c) whose
-// triangle holds all three corners to within `tolerance`, or -1. corners(f, k): corner k of
-// target face f.
+// The first of `faces` whose triangle holds all three corners to within `tolerance`, or -1.
+// corners(f, k): corner k of target face f. (Two faces can only both hold a non-degenerate
+// triangle when they are coplanar, and then their normals agree.)
 template <class Corners>
-int face_holding(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fm, int fa, int fb, int fc,
+int face_holding(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const std::vector<int>& faces,
                  const Corners& corners, double tolerance) {
-  for (const int f : {fm, fa, fb, fc}) {
-    if (f < 0) continue;
+  for (const int f : faces) {
     const Eigen::Vector3d p = corners(f, 0), q = corners(f, 1), r = corners(f, 2);
     bool holds = true;
     for (const Eigen::Vector3d* x : {&a, &b, &c}) holds = holds && (closest_on_triangle(*x, p, q, r).point - *x).norm() <= tolerance;
@@ -51,32 +54,43 @@ int face_holding(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
   return -1;
 }
 
-// closest(p, seed) -> the target face closest to p (seed: a face near p, or -1; only a hint).
+// closest(p, seed) -> a target face closest to p (seed: a face near p, or -1; only a hint).
+// tied(p, f, faces): appends to `faces` every other target face as close to p as f, to within
+// in_face (the faces a closest point on an edge or vertex touches, and any face as far).
 // area_vectors[f]: twice the area times the outward unit normal of target face f.
-// fa, fb, fc: the faces closest to a, b, c. corners(f, k): corner k of target face f; in_face:
-// kInFaceTolerance × the target's bounding-box diagonal (face_holding).
-template <class ClosestFace, class Corners>
+// fa, fb, fc: faces closest to a, b, c. corners(f, k): corner k of target face f; in_face:
+// kInFaceTolerance × the target's bounding-box diagonal (face_holding, ties).
+template <class ClosestFace, class TiedFaces, class Corners>
 bool image_triangle_flipped(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc,
-                            const std::vector<Eigen::Vector3d>& area_vectors, const ClosestFace& closest, const Corners& corners,
-                            double in_face) {
+                            const std::vector<Eigen::Vector3d>& area_vectors, const ClosestFace& closest, const TiedFaces& tied,
+                            const Corners& corners, double in_face) {
   const Eigen::Vector3d n = (b - a).cross(c - a);
   constexpr int kOrder = 4;
-  // The centroid, the corners, then the grid's points off the corners: at most 4 + 12 faces
-  // (a fixed array: this runs for every triangle the smoothing's guard judges).
-  std::array<int, 16> faces{};
-  int count = 0;
-  faces[count++] = closest((a + b + c) / 3, fa);
-  faces[count++] = fa;
-  faces[count++] = fb;
-  faces[count++] = fc;
+  // The faces closest to the centroid and the corners, then to the grid's points off the corners.
+  thread_local std::vector<int> faces;
+  faces.clear();
+  auto add = [&](const Eigen::Vector3d& p, int f) {
+    if (f < 0) return;
+    faces.push_back(f);
+    tied(p, f, faces);
+  };
+  const Eigen::Vector3d centroid = (a + b + c) / 3;
+  add(centroid, closest(centroid, fa));
+  add(a, fa);
+  add(b, fb);
+  add(c, fc);
+  auto distinct = [&]() {
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  };
+  distinct();
   // Inside one of those faces: that face alone decides.
-  const int holder = face_holding(a, b, c, faces[0], fa, fb, fc, corners, in_face);
+  const int holder = face_holding(a, b, c, faces, corners, in_face);
   if (holder >= 0) return n.dot(area_vectors[holder]) <= 0;
   auto faces_away = [&]() {
-    std::sort(faces.begin(), faces.begin() + count);
-    count = static_cast<int>(std::unique(faces.begin(), faces.begin() + count) - faces.begin());
+    distinct();
     Eigen::Vector3d nearby = Eigen::Vector3d::Zero();
-    for (int k = 0; k < count; ++k) nearby += area_vectors[faces[k]];
+    for (const int f : faces) nearby += area_vectors[f];
     return n.dot(nearby) <= 0;
   };
   if (!faces_away()) return false;
@@ -84,7 +98,8 @@ bool image_triangle_flipped(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
     for (int j = 0; i + j <= kOrder; ++j) {
       const int k = kOrder - i - j;
       if (i == kOrder || j == kOrder || k == kOrder) continue;  // the corners: already there
-      faces[count++] = closest((i * a + j * b + k * c) / kOrder, i >= j && i >= k ? fa : (j >= k ? fb : fc));
+      const Eigen::Vector3d p = (i * a + j * b + k * c) / kOrder;
+      add(p, closest(p, i >= j && i >= k ? fa : (j >= k ? fb : fc)));
     }
   return faces_away();
 }

@@ -34,7 +34,9 @@ struct MapAuditOptions {
 //                 vertices (several faces, so that a chord across a polycube edge, whose normal
 //                 lies between the two face normals, is not called flipped) and, on a second look
 //                 at a triangle that fails the first, of those closest to 15 points spread over it
-//                 (a chord from one face of a thin part to the opposite one; image_orientation.h)
+//                 (a chord from one face of a thin part to the opposite one; image_orientation.h).
+//                 Where faces tie for closest (a point on an edge or a vertex of the target) all
+//                 of them count, so the verdict does not depend on the frame the meshes are in
 //   degenerate    image triangles with area <= 1e-14 × target area, or with a non-finite vertex
 //   max_distance  largest distance of an image vertex from the target surface, / target bounding-box
 //                 diagonal (+infinity for a non-finite vertex)

@@ -2,17 +2,13 @@
 
 #include "polycube/barycentric.h"
 #include "polycube/closest_point.h"
-#include "polycube/image_orientation.h"
 #include "polycube/map_audit.h"
 #include "polycube/max_min_affine.h"
 
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
+#include "polycube/target_surface.h"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Simple_cartesian.h>
 
 #include <Eigen/Geometry>
 
@@ -789,31 +785,9 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
 // image triangle degenerate, or its normal against the area-weighted normals of the distinct
 // target faces closest to its centroid and corners, and then closest to points spread over it
 // (image_orientation.h).
-using Kernel = CGAL::Simple_cartesian<double>;
-using Point = Kernel::Point_3;
-using Triangle = Kernel::Triangle_3;
-using TriangleIterator = std::vector<Triangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
-
-class AuditTarget {
+class AuditTarget : public TargetSurface {
  public:
-  explicit AuditTarget(const TriMesh& target) : area_vectors_(target.num_faces()), tree_index_(target.num_faces(), -1) {
-    for (int f = 0; f < target.num_faces(); ++f) {
-      const Vec3 a = row(target.V, target.F(f, 0)), b = row(target.V, target.F(f, 1)), c = row(target.V, target.F(f, 2));
-      area_vectors_[f] = (b - a).cross(c - a);
-      area_ += 0.5 * area_vectors_[f].norm();
-      if (area_vectors_[f].squaredNorm() == 0) continue;
-      tree_index_[f] = static_cast<int>(triangles_.size());
-      triangles_.emplace_back(Point(a.x(), a.y(), a.z()), Point(b.x(), b.y(), b.z()), Point(c.x(), c.y(), c.z()));
-      faces_.push_back(f);
-    }
-    tree_.rebuild(triangles_.begin(), triangles_.end());
-    tree_.accelerate_distance_queries();
-    diagonal_ = (target.V.colwise().maxCoeff() - target.V.colwise().minCoeff()).norm();
-  }
-  AuditTarget(const AuditTarget&) = delete;
-  AuditTarget& operator=(const AuditTarget&) = delete;
+  explicit AuditTarget(const TriMesh& target) : TargetSurface(target, "smooth_map") {}
 
   // Per triangle of F placed at `image`: flipped or degenerate? `on` (optional, #V(image)) are the
   // images as points of the target, whose faces seed the closest-point queries (the answers are
@@ -836,56 +810,18 @@ class AuditTarget {
     std::vector<int> vertex_face(image.rows(), -1);
     parallel_range(static_cast<int>(image.rows()), threads, [&](int v) {
       if (!needed[v]) return;
-      const int seed = on && tree_index_[(*on)[v].face] >= 0 ? (*on)[v].face : -1;
       // A point well inside a face lies on no other (closed, self-intersection-free target).
-      vertex_face[v] = seed >= 0 && (*on)[v].bary.minCoeff() > 1e-9 ? seed : closest(row(image, v), seed);
+      const int seed = on && has_area((*on)[v].face) ? (*on)[v].face : -1;
+      vertex_face[v] = seed >= 0 && (*on)[v].bary.minCoeff() > 1e-9 ? seed : closest_face(row(image, v), seed);
     });
     std::vector<char> out = partial ? *previous : std::vector<char>(F.rows(), 0);
     parallel_range(static_cast<int>(F.rows()), threads, [&](int f) {
-      if (!recheck[f]) return;
-      out[f] = 0;
-      const Vec3 a = row(image, F(f, 0)), b = row(image, F(f, 1)), c = row(image, F(f, 2));
-      const Vec3 n = (b - a).cross(c - a);
-      if (0.5 * n.norm() <= kAuditDegenerateArea * area_) {
-        out[f] = 1;
-        return;
-      }
-      const auto corner = [this](int g, int k) -> Vec3 {
-        if (tree_index_[g] < 0) return Vec3::Constant(NAN);
-        const Point& r = triangles_[static_cast<size_t>(tree_index_[g])].vertex(k);
-        return Vec3(r.x(), r.y(), r.z());
-      };
-      const auto nearest = [this](const Vec3& p, int seed) { return closest(p, seed); };
-      if (image_triangle_flipped(a, b, c, vertex_face[F(f, 0)], vertex_face[F(f, 1)], vertex_face[F(f, 2)], area_vectors_, nearest, corner,
-                                 kInFaceTolerance * diagonal_))
-        out[f] = 1;
+      if (recheck[f])
+        out[f] = judge(row(image, F(f, 0)), row(image, F(f, 1)), row(image, F(f, 2)), vertex_face[F(f, 0)], vertex_face[F(f, 1)],
+                       vertex_face[F(f, 2)]) != 0;
     });
     return out;
   }
-
- private:
-  // The target face closest to p, as the audit finds it. A seed face near p speeds the search up;
-  // where the closest point lies on an edge or corner (a tie between faces, which the audit breaks
-  // by its own traversal order) the search is repeated without it, exactly as the audit runs it.
-  int closest(const Vec3& p, int seed) const {
-    const Point q(p.x(), p.y(), p.z());
-    auto plain = [&]() { return faces_[static_cast<size_t>(tree_.closest_point_and_primitive(q).second - triangles_.begin())]; };
-    if (seed < 0) return plain();
-    auto xyz = [](const Point& r) { return Vec3(r.x(), r.y(), r.z()); };
-    const auto seeded = triangles_.begin() + tree_index_[seed];
-    const Vec3 h = closest_on_triangle(p, xyz(seeded->vertex(0)), xyz(seeded->vertex(1)), xyz(seeded->vertex(2))).point;
-    const auto found = tree_.closest_point_and_primitive(q, Tree::Point_and_primitive_id(Point(h.x(), h.y(), h.z()), seeded)).second;
-    if (closest_on_triangle(p, xyz(found->vertex(0)), xyz(found->vertex(1)), xyz(found->vertex(2))).bary.minCoeff() <= 1e-9) return plain();
-    return faces_[static_cast<size_t>(found - triangles_.begin())];
-  }
-
-  std::vector<Vec3> area_vectors_;
-  double area_ = 0;
-  double diagonal_ = 0;
-  std::vector<Triangle> triangles_;
-  std::vector<int> faces_;
-  std::vector<int> tree_index_;  // per target face: its triangle in the tree (-1: zero area)
-  Tree tree_;
 };
 
 int count(const std::vector<char>& flags) { return static_cast<int>(std::count(flags.begin(), flags.end(), 1)); }

@@ -1,10 +1,12 @@
 #include "polycube/target_surface.h"
 
+#include "polycube/closest_point.h"
 #include "polycube/image_orientation.h"
 #include "polycube/map_audit.h"
 
 #include <Eigen/Geometry>
 
+#include <iterator>
 #include <stdexcept>
 #include <string>
 
@@ -12,13 +14,14 @@ namespace polycube {
 
 using namespace triangle_tree;
 
-TargetSurface::TargetSurface(const TriMesh& target, const char* what) : target_(target) {
+TargetSurface::TargetSurface(const TriMesh& target, const char* what) : target_(target), tree_index_(target.num_faces(), -1) {
   triangles_.reserve(target.num_faces());
   for (int f = 0; f < target.num_faces(); ++f) {
     const Eigen::Vector3d a = target.V.row(target.F(f, 0)).transpose();
     area_vectors_.push_back((target.V.row(target.F(f, 1)).transpose() - a).cross(target.V.row(target.F(f, 2)).transpose() - a));
     area_ += 0.5 * area_vectors_.back().norm();
     if (area_vectors_.back().squaredNorm() == 0) continue;
+    tree_index_[f] = static_cast<int>(triangles_.size());
     triangles_.emplace_back(point(target, target.F(f, 0)), point(target, target.F(f, 1)), point(target, target.F(f, 2)));
     faces_.push_back(f);
   }
@@ -30,9 +33,32 @@ TargetSurface::TargetSurface(const TriMesh& target, const char* what) : target_(
 
 int TargetSurface::judge(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, int fa, int fb, int fc) const {
   if (0.5 * (b - a).cross(c - a).norm() <= kAuditDegenerateArea * area_) return 2;
-  const auto corner = [this](int f, int k) -> Eigen::Vector3d { return target_.V.row(target_.F(f, k)); };
-  const auto nearest = [this](const Eigen::Vector3d& p, int) { return closest(p).first; };
-  return image_triangle_flipped(a, b, c, fa, fb, fc, area_vectors_, nearest, corner, kInFaceTolerance * diagonal_) ? 1 : 0;
+  const double in_face = kInFaceTolerance * diagonal_;
+  const auto corners = [this](int f, int k) { return corner(f, k); };
+  const auto nearest = [this](const Eigen::Vector3d& p, int seed) { return closest_face(p, seed); };
+  const auto tied = [this, in_face](const Eigen::Vector3d& p, int f, std::vector<int>& faces) { tied_faces(p, f, in_face, faces); };
+  return image_triangle_flipped(a, b, c, fa, fb, fc, area_vectors_, nearest, tied, corners, in_face) ? 1 : 0;
+}
+
+int TargetSurface::closest_face(const Eigen::Vector3d& p, int seed) const {
+  const Point q(p.x(), p.y(), p.z());
+  if (seed < 0 || seed >= static_cast<int>(tree_index_.size()) || tree_index_[seed] < 0) return closest(p).first;
+  const auto seeded = triangles_.begin() + tree_index_[seed];
+  const Eigen::Vector3d h = closest_on_triangle(p, corner(seed, 0), corner(seed, 1), corner(seed, 2)).point;
+  const auto found = tree_.closest_point_and_primitive(q, Tree::Point_and_primitive_id(Point(h.x(), h.y(), h.z()), seeded)).second;
+  return faces_[static_cast<size_t>(found - triangles_.begin())];
+}
+
+void TargetSurface::tied_faces(const Eigen::Vector3d& p, int f, double tolerance, std::vector<int>& faces) const {
+  const double reach = (closest_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2)).point - p).norm() + tolerance;
+  const CGAL::Bbox_3 box(p.x() - reach, p.y() - reach, p.z() - reach, p.x() + reach, p.y() + reach, p.z() + reach);
+  thread_local std::vector<Tree::Primitive_id> hits;
+  hits.clear();
+  tree_.all_intersected_primitives(box, std::back_inserter(hits));
+  for (const auto& hit : hits) {
+    const int g = faces_[static_cast<size_t>(hit - triangles_.begin())];
+    if (g != f && (closest_on_triangle(p, corner(g, 0), corner(g, 1), corner(g, 2)).point - p).norm() <= reach) faces.push_back(g);
+  }
 }
 
 std::pair<int, double> TargetSurface::closest(const Eigen::Vector3d& p) const {

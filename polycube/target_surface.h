@@ -1,8 +1,9 @@
 // Internal (CGAL; include only from engine .cpp files): closest points on the surface a map's
 // images should lie on, with the faces' area vectors the orientation test needs, and the audit's
 // judgement of one image triangle. Shared by the audit (map_audit.cpp), the refinement of P's
-// sampling (map_refinement.cpp) and the last untangling (image_untangle.cpp), which must find the
-// same closest faces (the same tree over the same triangles breaks every tie the same way).
+// sampling (map_refinement.cpp), the smoothing's guard (map_smoothing.cpp) and the last
+// untangling (image_untangle.cpp), which must judge exactly as the audit does. Faces tied for
+// closest are all taken (tied_faces), so no verdict depends on how the tree breaks ties.
 #pragma once
 
 #include "polycube/mesh.h"
@@ -31,6 +32,21 @@ class TargetSurface {
   // Closest point of the target to p and its face.
   std::pair<Eigen::Vector3d, int> project(const Eigen::Vector3d& p) const;
 
+  // A target face closest to p, the search started from `seed` (a face near p, or -1: only a
+  // hint; faces of zero area are never returned).
+  int closest_face(const Eigen::Vector3d& p, int seed) const;
+
+  // Appends to `faces` every target face other than f whose distance to p is at most f's plus
+  // `tolerance`: with f closest to p, the faces tied with it (those touching p's closest point
+  // when it lies on an edge or a vertex, and any other as near).
+  void tied_faces(const Eigen::Vector3d& p, int f, double tolerance, std::vector<int>& faces) const;
+
+  // Whether face f has an area (faces without are not in the tree and never closest).
+  bool has_area(int f) const { return tree_index_[f] >= 0; }
+
+  // Corner k of target face f.
+  Eigen::Vector3d corner(int f, int k) const { return target_.V.row(target_.F(f, k)).transpose(); }
+
   // Per target face: twice the area times the outward unit normal.
   const std::vector<Eigen::Vector3d>& area_vectors() const { return area_vectors_; }
 
@@ -47,7 +63,8 @@ class TargetSurface {
   TriMesh target_;
   std::vector<Eigen::Vector3d> area_vectors_;
   std::vector<triangle_tree::Triangle> triangles_;
-  std::vector<int> faces_;  // target face of each tree triangle
+  std::vector<int> faces_;       // target face of each tree triangle
+  std::vector<int> tree_index_;  // per target face: its tree triangle (-1: zero area)
   double area_ = 0, diagonal_ = 0;
   triangle_tree::Tree tree_;
 };

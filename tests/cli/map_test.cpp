@@ -1,6 +1,7 @@
 // End-to-end: `polycube map` through the real binary: outputs, report, and clean failures.
 #include "formats/image_io.h"
 #include "formats/mesh_io.h"
+#include "polycube/map_audit.h"
 #include "polycube/validate.h"
 #include "support/test_support.h"
 
@@ -146,6 +147,16 @@ TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
   EXPECT_EQ(report.at("map").at("flipped_disk_triangles").get<int>(), 0);
   EXPECT_LT(report.at("map").at("polycube_to_model").at("max_distance").get<double>(), 1e-9);
   EXPECT_LT(report.at("map").at("model_to_polycube").at("max_distance").get<double>(), 1e-9);
+
+  // The files, audited as written (in the input frame, the map having been built in the chosen
+  // one), give the report's verdicts: an outside audit of what a user reads agrees with ours.
+  const TriMesh P = test::load_mesh_file(dir + "/polycube.obj"), M = test::load_mesh_file(test::data_path("knot.off"));
+  const MapAudit files = audit_map(M, P, test::load_mesh_file(dir + "/polycube_on_model.obj").V, test::load_mesh_file(dir + "/model_on_polycube.obj").V);
+  EXPECT_EQ(files.polycube_to_model.flipped, report.at("map").at("polycube_to_model").at("flipped").get<int>());
+  EXPECT_EQ(files.model_to_polycube.flipped, report.at("map").at("model_to_polycube").at("flipped").get<int>());
+  EXPECT_EQ(files.polycube_to_model.degenerate, report.at("map").at("polycube_to_model").at("degenerate").get<int>());
+  EXPECT_EQ(files.model_to_polycube.degenerate, report.at("map").at("model_to_polycube").at("degenerate").get<int>());
+  EXPECT_NEAR(files.polycube_to_model.area_ratio, report.at("map").at("polycube_to_model").at("area_ratio").get<double>(), 1e-9);
 }
 
 // A finished map's rank as `map` ranks them: flipped and degenerate triangles both ways, whether

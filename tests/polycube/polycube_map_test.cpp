@@ -79,6 +79,20 @@ TEST_P(PolycubeMapOnMeshes, DisksEmbedImagesOnSurfacesRoundTrip) {
   EXPECT_LT(audit.model_to_polycube.max_distance, 1e-9) << name;
   EXPECT_EQ(audit.polycube_to_model.degenerate + audit.model_to_polycube.degenerate, 0) << name;
 
+  // The audit's verdicts do not depend on the frame: the unsmoothed map's images lie on P's edges
+  // and vertices, where faces tie for closest; the same meshes and images turned (an exact axis
+  // permutation with a reflection-free sign change, and a generic rotation) audit the same.
+  for (const Eigen::Matrix3d& R : {Eigen::Matrix3d((Eigen::Matrix3d() << 0, 1, 0, 0, 0, -1, -1, 0, 0).finished()),
+                                   Eigen::Matrix3d(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix())}) {
+    TriMesh model_turned = model, P_turned = P;
+    model_turned.V = model.V * R.transpose();
+    P_turned.V = P.V * R.transpose();
+    const MapAudit turned = audit_map(model_turned, P_turned, p.map.polycube_on_model_xyz * R.transpose(),
+                                      p.map.model_on_polycube_xyz * R.transpose());
+    EXPECT_EQ(turned.polycube_to_model.flipped, audit.polycube_to_model.flipped) << name;
+    EXPECT_EQ(turned.model_to_polycube.flipped, audit.model_to_polycube.flipped) << name;
+  }
+
   // φ⁻¹ ∘ φ and φ ∘ φ⁻¹ are the identity at random points.
   const double diagonal = bounding_box(model.V).diagonal();
   std::mt19937 rng(7);
