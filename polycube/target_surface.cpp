@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <iterator>
 #include <stdexcept>
 #include <string>
@@ -50,7 +51,21 @@ int TargetSurface::closest_face(const Eigen::Vector3d& p, int seed) const {
 }
 
 void TargetSurface::tied_faces(const Eigen::Vector3d& p, int f, double tolerance, std::vector<int>& faces) const {
-  const double reach = (closest_on_triangle(p, corner(f, 0), corner(f, 1), corner(f, 2)).point - p).norm() + tolerance;
+  const Eigen::Vector3d a = corner(f, 0), b = corner(f, 1), c = corner(f, 2);
+  const Eigen::Vector3d q = closest_on_triangle(p, a, b, c).point;
+  const double distance = (q - p).norm();
+  if (distance <= tolerance) {
+    // A point on f farther than the tolerance from f's edges touches no other face (the target
+    // is closed and free of self-intersections; another sheet within the tolerance counts as
+    // none): the common case of an image inside a face, answered without a search.
+    auto off_edge = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+      const Eigen::Vector3d e = v - u;
+      const double t = std::clamp((q - u).dot(e) / e.squaredNorm(), 0.0, 1.0);
+      return (u + t * e - q).norm() > tolerance;
+    };
+    if (off_edge(a, b) && off_edge(b, c) && off_edge(c, a)) return;
+  }
+  const double reach = distance + tolerance;
   const CGAL::Bbox_3 box(p.x() - reach, p.y() - reach, p.z() - reach, p.x() + reach, p.y() + reach, p.z() + reach);
   thread_local std::vector<Tree::Primitive_id> hits;
   hits.clear();

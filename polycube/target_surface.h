@@ -38,7 +38,9 @@ class TargetSurface {
 
   // Appends to `faces` every target face other than f whose distance to p is at most f's plus
   // `tolerance`: with f closest to p, the faces tied with it (those touching p's closest point
-  // when it lies on an edge or a vertex, and any other as near).
+  // when it lies on an edge or a vertex, and any other as near). A point on f (within the
+  // tolerance) farther than the tolerance from f's edges gets none without a search: another
+  // sheet of the target that close is taken as absent.
   void tied_faces(const Eigen::Vector3d& p, int f, double tolerance, std::vector<int>& faces) const;
 
   // Whether face f has an area (faces without are not in the tree and never closest).
