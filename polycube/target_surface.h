@@ -36,11 +36,12 @@ class TargetSurface {
   // hint; faces of zero area are never returned).
   int closest_face(const Eigen::Vector3d& p, int seed) const;
 
-  // Appends to `faces` every target face other than f whose distance to p is at most f's plus
-  // `tolerance`: with f closest to p, the faces tied with it (those touching p's closest point
-  // when it lies on an edge or a vertex, and any other as near). A point on f (within the
-  // tolerance) farther than the tolerance from f's edges gets none without a search: another
-  // sheet of the target that close is taken as absent.
+  // Appends to `faces` the target faces other than f tied with it for closest to p: with q the
+  // point of f closest to p, when q lies within `tolerance` of an edge of f, every face passing
+  // within `tolerance` of q (q being a point of those faces too, they are as near to p). A q
+  // inside f, farther than the tolerance from its edges, gets none (another sheet of the target
+  // that close is taken as absent, and a face elsewhere within rounding of p's distance to f
+  // as not there: a tie no frame makes likelier).
   void tied_faces(const Eigen::Vector3d& p, int f, double tolerance, std::vector<int>& faces) const;
 
   // Whether face f has an area (faces without are not in the tree and never closest).
