@@ -1,6 +1,8 @@
 // audit_map / audit_map_direction: the outside check of a claimed bijection, on maps whose flaws
 // are known by construction (swapped or reflected images, images off the surface, a double
 // cover), and on chords across convex and concave polycube edges that must not count as flipped.
+#include "polycube/closest_point.h"
+#include "polycube/image_orientation.h"
 #include "polycube/map_audit.h"
 
 #include "polycube/target_surface.h"
@@ -11,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
@@ -371,6 +374,36 @@ TEST(MapAudit, ChordsAcrossConvexEdgesAndCornersAreNotFlipped) {
   EXPECT_LT(audit.area_ratio, 1) << "chords cut the edges off";
   const MapDirectionAudit inverted = audit_map_direction(reversed(chamfered), chamfered.V, cube);
   EXPECT_EQ(inverted.flipped, chamfered.num_faces());
+}
+
+// The faces tied for closest to a point (TargetSurface::tied_faces) are every face through the
+// point's closest point: at a corner of the lattice cube all the triangles round it, on an edge
+// those of both squares, inside a square only the triangle holding it (on its diagonal, both);
+// off the surface likewise, for the closest point. Checked against all faces by brute force.
+TEST(MapAudit, TiedFacesAreEveryFaceThroughTheClosestPoint) {
+  const TriMesh cube = lattice_cube(2);
+  const TargetSurface surface(cube, "test");
+  const double tolerance = kInFaceTolerance * surface.diagonal();
+  struct Case {
+    Eigen::Vector3d p;
+    int at_least;
+  };
+  const std::vector<Case> cases = {{{0, 0, 0}, 3},          {{2, 2, 2}, 3},        {{1, 0, 0}, 2},          {{0.5, 0, 0}, 2},
+                                   {{2, 0.7, 2}, 2},        {{1, 1, 0}, 4},        {{0.3, 0.6, 0}, 1},      {{0.25, 0.25, 0}, 1},
+                                   {{-0.5, -0.5, 0.3}, 2},  {{-1, -1, -1}, 3},     {{0.4, 1.3, -0.7}, 1},   {{1.0 / 3, 2.0 / 3, 2}, 1}};
+  for (const Case& c : cases) {
+    const auto [f, distance] = surface.closest(c.p);
+    std::vector<int> tied = {f};
+    surface.tied_faces(c.p, f, tolerance, tied);
+    std::sort(tied.begin(), tied.end());
+    std::vector<int> brute;
+    for (int g = 0; g < cube.num_faces(); ++g) {
+      const Eigen::Vector3d a = cube.V.row(cube.F(g, 0)), b = cube.V.row(cube.F(g, 1)), d = cube.V.row(cube.F(g, 2));
+      if ((closest_on_triangle(c.p, a, b, d).point - c.p).norm() <= distance + tolerance) brute.push_back(g);
+    }
+    EXPECT_EQ(tied, brute) << c.p.transpose();
+    EXPECT_GE(static_cast<int>(tied.size()), c.at_least) << c.p.transpose();
+  }
 }
 
 TEST(MapAudit, ChordsAcrossConcaveAndConvexEdgesOfAnLShapeAreNotFlipped) {
