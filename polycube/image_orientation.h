@@ -8,9 +8,9 @@
 //   2. otherwise a second, finer look: the faces closest to the 15 points of the barycentric grid
 //      of order 4 (corners and edge points included) and the centroid; flipped only if the
 //      chord faces away from their sum too.
-// "The faces closest to a point" are all the faces as close to it as the closest one, to within
-// the in-face tolerance: a corner on an edge of the target brings both faces there, a corner on
-// a vertex every face round it. One face picked among tied ones would depend on how a search
+// "The faces closest to a point" are every face through its closest point on the target, to
+// within the in-face tolerance: a corner on an edge of the target brings both faces there, a
+// corner on a vertex every face round it (TargetSurface::tied_faces). One face picked among tied ones would depend on how a search
 // tree breaks ties, and so on the frame the meshes are given in: the audit of the files a user
 // reads (in the input frame) must be the audit the stages ran (in the frame they chose).
 // The first look alone misjudges chords whose corners lie on opposite faces of P — across a thin
@@ -55,8 +55,8 @@ int face_holding(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen
 }
 
 // closest(p, seed) -> a target face closest to p (seed: a face near p, or -1; only a hint).
-// tied(p, f, faces): appends to `faces` every other target face as close to p as f, to within
-// in_face (the faces a closest point on an edge or vertex touches, and any face as far).
+// tied(p, f, faces): appends to `faces` every other target face through p's closest point on f,
+// to within in_face (when that point lies on an edge or a vertex of f).
 // area_vectors[f]: twice the area times the outward unit normal of target face f.
 // fa, fb, fc: faces closest to a, b, c. corners(f, k): corner k of target face f; in_face:
 // kInFaceTolerance × the target's bounding-box diagonal (face_holding, ties).

@@ -9,7 +9,6 @@
 #include "polycube/parallel.h"
 #include "polycube/target_surface.h"
 
-
 #include <Eigen/Geometry>
 
 #include <algorithm>
