@@ -8,7 +8,8 @@ Default meshes: every mesh of ../shared/data/paper and ../shared/data/dev when p
 (laurana-open with --fill-holes). Per mesh, from the --report JSON: quads, irregular vertices and
 P's cone points, the refinement's rounds, halved chord parts and template rounds, angle deviation from 90° (mean / p95 / max), flipped quads / inverted corners,
 degenerate quads, the Hausdorff distance (% of the diagonal, both one-sided distances), the fit's
-pulled corners, seconds per stage, wall time and peak RSS (/usr/bin/time). Standard library only.
+pulled corners, the triangles the map was built on (the model's long edges split: rounds), seconds
+per stage, wall time and peak RSS (/usr/bin/time). Standard library only.
 """
 import argparse
 import os
@@ -35,13 +36,13 @@ def main():
     a = ap.parse_args()
     meshes = a.meshes or default_meshes()
     extra = a.extra_args.split() if a.extra_args else []
-    stage_names = ("read", "align", "topology", "polycube", "map", "grid", "carry", "smooth", "fit", "untangle", "refine", "quality", "retry")
+    stage_names = ("read", "split", "align", "topology", "polycube", "map", "grid", "carry", "smooth", "fit", "untangle", "refine", "quality", "retry")
     rows = []
     for mesh in meshes:
         name = pathlib.Path(mesh).stem
         code, r, wall, rss, error = run(a.binary, mesh, extra)
         if r is None:
-            rows.append("| %s | failed (exit %d): %s |%s %.2f | %.0f |" % (name, code, error.replace("|", "/"), " |" * 11, wall, rss))
+            rows.append("| %s | failed (exit %d): %s |%s %.2f | %.0f |" % (name, code, error.replace("|", "/"), " |" * 12, wall, rss))
             print(name, "failed", error, file=sys.stderr)
             continue
         q, s = r["quality"], r["seconds"]
@@ -50,15 +51,17 @@ def main():
         diag = q["diagonal"]
         stages = " / ".join("%.2f" % s.get(k, 0) for k in stage_names)
         g = r.get("grid", {})
-        rows.append("| %s | %d | %d / %d / %d | %d | %d | %.2f / %.1f / %.1f | %d / %d | %d | %.3f (%.3f / %.3f) | %d | %s | %.2f | %.2f | %.0f |" % (
+        split = r.get("split", {})
+        rows.append("| %s | %d | %d / %d / %d | %d | %d | %.2f / %.1f / %.1f | %d / %d | %d | %.3f (%.3f / %.3f) | %d | %s | %s | %.2f | %.2f | %.0f |" % (
             name, q["quads"], g.get("refine_rounds", 0), g.get("refined_chord_parts", 0), g.get("template_rounds", 0), q["irregular_vertices"], q["irregular_at_corners"], ang["mean"], ang["p95"], ang["max"],
             q["flipped_quads"], q["inverted_corners"], q["degenerate_quads"], q["hausdorff_percent_diagonal"],
             100 * sides["quads_to_model"] / diag, 100 * sides["model_to_quads"] / diag,
-            r.get("fitting", {}).get("snapped", 0), stages, s["total"], wall, rss))
+            r.get("fitting", {}).get("snapped", 0),
+            "%d (%d)" % (split["triangles"], split["rounds"]) if split else "-", stages, s["total"], wall, rss))
         print(rows[-1], file=sys.stderr)
     header = [
-        "| mesh | quads | refinement rounds / parts halved / template rounds | irregular | of them at P's cones | angle dev. mean / p95 / max ° | flipped / inverted corners | degenerate | Hausdorff % diag (quads→model / model→quads) | corners pulled by the fit | seconds " + " / ".join(stage_names) + " | total s | wall s | peak RSS MB |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| mesh | quads | refinement rounds / parts halved / template rounds | irregular | of them at P's cones | angle dev. mean / p95 / max ° | flipped / inverted corners | degenerate | Hausdorff % diag (quads→model / model→quads) | corners pulled by the fit | triangles mapped (split rounds) | seconds " + " / ".join(stage_names) + " | total s | wall s | peak RSS MB |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     with open(a.output, "w") as f:
         f.write("\n".join(header + rows) + "\n")

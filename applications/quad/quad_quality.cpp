@@ -105,7 +105,7 @@ QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& referen
   }
 
   if (options.hausdorff && r.quads > 0) {
-    const HausdorffDistance d = hausdorff_distance(triangulate_quads(quads), reference.surface(), options.sampling);
+    const HausdorffDistance d = hausdorff_distance(triangulate_quads(quads), reference.sampled(), options.sampling);
     r.hausdorff_measured = true;
     r.hausdorff = d.hausdorff;
     r.hausdorff_percent = r.diagonal > 0 ? 100 * d.hausdorff / r.diagonal : 0;

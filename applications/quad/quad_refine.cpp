@@ -63,7 +63,7 @@ SurfacePoint PreimageLocator::on_polycube(const Eigen::Vector3d& p) const {
 
 QuadMiss find_quad_misses(const PolycubeGrid& grid, const QuadMesh& quads, const SurfaceProjector& model,
                           const PreimageLocator& locator, double distance, double cell_size, int threads) {
-  const TriMesh& surface = model.surface();
+  const TriMesh& surface = model.sampled();
   const SurfaceProjector on_quads(triangulate_quads(quads));
   // Points of M (its vertices, centroids of long triangles, points along long edges, a quarter
   // cell apart).

@@ -411,7 +411,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     throw std::invalid_argument("fitting: " + std::to_string(pinned.size()) + " pinned flags for " + std::to_string(nv) + " vertices");
   result.pinned = pinned.empty() ? std::vector<char>(nv, 0) : pinned;
   if (mesh.num_quads() == 0 || options.passes == 0) return result;
-  const TriMesh& model = surface.surface();
+  const TriMesh& model = surface.sampled();
   const double tolerance = options.tolerance * bounding_box(model.V).diagonal();
   const std::vector<std::vector<int>> neighbours = vertex_neighbours(mesh.Q, nv);
   const std::vector<std::vector<int>> around = vertex_quads(mesh.Q, nv);

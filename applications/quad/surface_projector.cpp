@@ -54,6 +54,7 @@ struct SurfaceProjector::Impl {
   Eigen::MatrixX3d vertex_normals;
   std::vector<Triangle> triangles;
   Tree tree;
+  TriMesh sampled;  // empty: the surface
   // For the walks of closest_on_sheet: the face across each edge of a face (-1: none), the faces
   // round each vertex (CSR).
   Eigen::MatrixX3i across;
@@ -96,6 +97,11 @@ SurfaceProjector::SurfaceProjector(const TriMesh& surface) : impl_(std::make_uni
       impl_->across(f, i) = edges.face_count[e] == 2 ? other : -1;
     }
   impl_->ring = vertex_faces(surface.F, surface.num_vertices());
+}
+
+SurfaceProjector::SurfaceProjector(const TriMesh& surface, const TriMesh& sampled) : SurfaceProjector(surface) {
+  if (sampled.num_faces() == 0) throw std::invalid_argument("cannot sample a surface by a mesh without faces");
+  impl_->sampled = sampled;
 }
 
 SurfaceProjector::~SurfaceProjector() = default;
@@ -255,6 +261,8 @@ std::vector<SurfaceHit> closest_to_samples(const SurfaceProjector& surface, cons
 }
 
 const TriMesh& SurfaceProjector::surface() const { return impl_->surface; }
+
+const TriMesh& SurfaceProjector::sampled() const { return impl_->sampled.num_faces() > 0 ? impl_->sampled : impl_->surface; }
 
 Eigen::Vector3d SurfaceProjector::face_normal(int f) const { return impl_->normals.row(f); }
 

@@ -31,6 +31,12 @@ class SurfaceProjector {
  public:
   // Throws std::invalid_argument for a mesh without faces.
   explicit SurfaceProjector(const TriMesh& surface);
+  // The same, and `sampled`: another triangulation of the same surface (the model as read, when
+  // `surface` is its split_long_edges copy, whose interpolated normals stay true inside the
+  // model's large flat triangles) that sampled() hands to those who sample the surface (the fit,
+  // the refinement's misses, the measure): its vertices and points along its long edges, as
+  // many as the model as read has, not the copy's.
+  SurfaceProjector(const TriMesh& surface, const TriMesh& sampled);
   ~SurfaceProjector();
   SurfaceProjector(const SurfaceProjector&) = delete;
   SurfaceProjector& operator=(const SurfaceProjector&) = delete;
@@ -48,6 +54,8 @@ class SurfaceProjector {
   SurfaceHit closest_on_sheet(const Eigen::Vector3d& query, const SurfaceHit& hint) const;
 
   const TriMesh& surface() const;
+  // The triangulation to sample the surface by: `sampled` as given, else the surface.
+  const TriMesh& sampled() const;
   // Unit outward normal of triangle f (zero for a degenerate one).
   Eigen::Vector3d face_normal(int f) const;
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <tuple>
 
@@ -236,6 +237,53 @@ TEST(QuadCli, QuadsStillShortTryFinerContours) {
   EXPECT_GE(plain, 1u);
   EXPECT_GE(kept_thin, 1u);
   EXPECT_EQ(quad_topology(read_quads(dir + "/thin.obj")).genus(), 2);
+}
+
+// A coarse model (CGAL's corner tetrahedron, 4 triangles) gets its long edges split before the
+// map is built: the map's disk maps on 4 triangles shear the quads (about 29 deg mean angle
+// deviation from 90 at 1000 quads, one orientation, no refinement), on the split model they do
+// not (about 9). The quads lie on the model as read and are measured against it.
+TEST(QuadCli, CoarseModelIsSplitBeforeTheMap) {
+  const std::string dir = test::temp_dir("quad-split");
+  const std::string base = "quad " + quoted(test::data_path("tetrahedron.off")) +
+                           " --target-faces 1000 --align none --refine 0 --finer-contours 1 --thin-parts 0 --quiet";
+  const auto run = [&](const std::string& name, const std::string& extra) {
+    const std::string out = dir + "/" + name + ".obj", report_path = dir + "/" + name + ".json";
+    const test::CliRun r = polycube_cli(base + extra + " -o " + quoted(out) + " --report " + quoted(report_path));
+    EXPECT_EQ(r.code, 0) << r.err;
+    const QuadMesh quads = read_quads(out);
+    const QuadTopology t = quad_topology(quads);
+    EXPECT_TRUE(t.closed_manifold()) << name;
+    EXPECT_EQ(t.genus(), 0) << name;
+    // Every quad vertex on the tetrahedron's surface (its faces are the planes x, y, z = 0 and
+    // x + y + z = 1): on one of them, inside the others.
+    for (int v = 0; v < quads.num_vertices(); ++v) {
+      const Eigen::Vector3d p = quads.V.row(v);
+      const double off = std::min({std::abs(p.x()), std::abs(p.y()), std::abs(p.z()), std::abs(p.sum() - 1) / std::sqrt(3.0)});
+      EXPECT_LT(off, 1e-9) << name << " vertex " << v;
+      EXPECT_GT(p.minCoeff(), -1e-9) << name << " vertex " << v;
+      EXPECT_LT(p.sum(), 1 + 1e-9) << name << " vertex " << v;
+    }
+    return nlohmann::json::parse(test::read_file(report_path));
+  };
+  const nlohmann::json split = run("split", "");
+  const nlohmann::json whole = run("whole", " --split-edges 0");
+  EXPECT_EQ(split["parameters"]["split_edges"].get<double>(), 2.0);
+  // Edges of 1 and sqrt 2 against twice the quad size (sqrt(area / 1000) = 0.047): four rounds,
+  // every triangle split into four each time.
+  EXPECT_EQ(split["split"]["rounds"].get<int>(), 4);
+  EXPECT_EQ(split["split"]["triangles"].get<int>(), 4 * 256);
+  EXPECT_FALSE(split["split"]["capped"].get<bool>());
+  EXPECT_EQ(whole["split"]["rounds"].get<int>(), 0);
+  EXPECT_EQ(whole["split"]["triangles"].get<int>(), 4);
+  const double split_angle = split["quality"]["angle_deviation_degrees"]["mean"].get<double>();
+  const double whole_angle = whole["quality"]["angle_deviation_degrees"]["mean"].get<double>();
+  EXPECT_LT(split_angle, 15.0);
+  EXPECT_LT(split_angle, whole_angle / 2);
+  EXPECT_EQ(split["quality"]["flipped_quads"].get<int>(), 0);
+  EXPECT_LT(split["quality"]["hausdorff_percent_diagonal"].get<double>(), whole["quality"]["hausdorff_percent_diagonal"].get<double>());
+  // The measure is against the model as read: the same diagonal either way.
+  EXPECT_DOUBLE_EQ(split["quality"]["diagonal"].get<double>(), whole["quality"]["diagonal"].get<double>());
 }
 
 TEST(QuadCli, CleanErrors) {
