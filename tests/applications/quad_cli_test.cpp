@@ -274,7 +274,16 @@ TEST(QuadCli, CoarseModelIsSplitBeforeTheMap) {
   EXPECT_EQ(split["split"]["rounds"].get<int>(), 4);
   EXPECT_EQ(split["split"]["triangles"].get<int>(), 4 * 256);
   EXPECT_FALSE(split["split"]["capped"].get<bool>());
+  // Beyond the bound (no refinement here), the split model's quads meet the whole search on the
+  // model as read, and are kept: they are nearer the model.
+  EXPECT_TRUE(split["split"]["kept"].get<bool>());
+  ASSERT_TRUE(split["alignment"].contains("tried"));
+  bool as_read_tried = false;
+  for (const nlohmann::json& t : split["alignment"]["tried"])
+    as_read_tried = as_read_tried || t["name"].get<std::string>().find(", model as read") != std::string::npos;
+  EXPECT_TRUE(as_read_tried);
   EXPECT_EQ(whole["split"]["rounds"].get<int>(), 0);
+  EXPECT_FALSE(whole["split"]["kept"].get<bool>());
   EXPECT_EQ(whole["split"]["triangles"].get<int>(), 4);
   const double split_angle = split["quality"]["angle_deviation_degrees"]["mean"].get<double>();
   const double whole_angle = whole["quality"]["angle_deviation_degrees"]["mean"].get<double>();
