@@ -403,31 +403,38 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // Still short, on the split model: the whole search again on the model as read (its own first
   // search before the split, uncapped). The split is what CAD models need, but on coarse organic
   // ones whose quads fall short (thin parts, folds) it was no better and sometimes worse (femur's
-  // first try: 33 flipped quads and 2.51 % against 1 and 1.37 %). The searches after this one run
-  // on whichever model gave the best quads so far.
+  // first try: 33 flipped quads and 2.51 % against 1 and 1.37 %).
   if (kept->worth_retrying() && options.map_dir.empty() && split_model.split)
     search_again(options.polycube, "model_as_read", ", model as read", "on the model as read (long edges not split)", as_read,
                  false);
+  // The later searches run on the model as read, then on the split model: so every search made
+  // before the split still runs when the quads fall short (cow's best, 2.49 % and no flipped quad,
+  // came from the model as read with finer contours; its split model's searches kept 7 flipped).
+  std::vector<const QuadModel*> models = {&as_read};
+  if (split_model.split) models.push_back(&split_model);
+  const auto model_key = [&](const std::string& key, const QuadModel& on) { return on.split || !split_model.split ? key : key + "_as_read"; };
+  const auto model_suffix = [&](const QuadModel& on) { return on.split || !split_model.split ? "" : ", model as read"; };
   // Still short: once more with finer contours, as `map` does (a thin part that d_a drops from P
   // is squeezed by the map, and the quads carried through it cut across it).
-  if (kept->worth_retrying() && options.map_dir.empty() && options.finer_contours > 1) {
+  for (const QuadModel* on : models) {
+    if (!kept->worth_retrying() || !options.map_dir.empty() || options.finer_contours <= 1) break;
     PolycubeOptions finer = options.polycube;
     finer.da = options.polycube.da / options.finer_contours;
     std::ostringstream suffix;
-    suffix << ", finer contours (d_a " << finer.da << ")";
-    search_again(finer, "finer_contours", suffix.str() + (kept->on->split ? "" : ", model as read"),
-                 "with d_a " + std::to_string(finer.da), *kept->on, true);
+    suffix << ", finer contours (d_a " << finer.da << ")" << model_suffix(*on);
+    search_again(finer, model_key("finer_contours", *on), suffix.str(), "with d_a " + std::to_string(finer.da) + model_suffix(*on), *on,
+                 true);
   }
   // Still short: once more keeping thin parts (a tail or a fin whose area is small beside its
   // section's, so d_a drops it from P and the map squeezes it; bull: 7.25 % -> 0.39 % of the
   // diagonal).
-  if (kept->worth_retrying() && options.map_dir.empty() && options.thin_parts > 0) {
+  for (const QuadModel* on : models) {
+    if (!kept->worth_retrying() || !options.map_dir.empty() || options.thin_parts <= 0) break;
     PolycubeOptions thin = options.polycube;
     thin.feature_distance = options.thin_parts;
     std::ostringstream suffix;
-    suffix << ", thin parts kept (" << thin.feature_distance << ")";
-    search_again(thin, "thin_parts", suffix.str() + (kept->on->split ? "" : ", model as read"), "keeping thin parts", *kept->on,
-                 true);
+    suffix << ", thin parts kept (" << thin.feature_distance << ")" << model_suffix(*on);
+    search_again(thin, model_key("thin_parts", *on), suffix.str(), "keeping thin parts" + std::string(model_suffix(*on)), *on, true);
   }
   if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;
