@@ -412,7 +412,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // came from the model as read with finer contours; its split model's searches kept 7 flipped).
   std::vector<const QuadModel*> models = {&as_read};
   if (split_model.split) models.push_back(&split_model);
-  const auto model_key = [&](const std::string& key, const QuadModel& on) { return on.split || !split_model.split ? key : key + "_as_read"; };
+  const auto model_key = [&](const std::string& key, const QuadModel& on) { return on.split ? key + "_split" : key; };
   const auto model_suffix = [&](const QuadModel& on) { return on.split || !split_model.split ? "" : ", model as read"; };
   // Still short: once more with finer contours, as `map` does (a thin part that d_a drops from P
   // is squeezed by the map, and the quads carried through it cut across it).
