@@ -1,11 +1,12 @@
 // Finer triangulation of the same surface: long edges split at their midpoints. A coarse model
 // (a CAD tetrahedron of 4 triangles, a cube of 12) gives the map's harmonic disk maps almost no
 // interior vertices, so the map P → M shears whatever is carried through it (the quads'
-// angles); the same surface with short edges does not. Not CGAL's
-// Polygon_mesh_processing::split_long_edges: it joins each midpoint to the opposite corners, so a
-// large triangle becomes a fan of slivers (the disk maps' cotangent weights are clamped on
-// slivers); nor its isotropic remeshing, which moves vertices (the surface changes at creases
-// unless they are found and protected). Neither was measured here.
+// angles); the same surface with short edges does not. Not tried: CGAL's
+// Polygon_mesh_processing::split_long_edges (documented for splitting constrained edges before
+// an isotropic remeshing; how it triangulates the faces round the new vertices decides the
+// triangles' shapes, which the disk maps' clamped cotangent weights need) and its isotropic
+// remeshing (moves vertices: the surface changes at creases unless they are found and protected).
+// Red splits keep a well-shaped triangle's pieces similar to it.
 #pragma once
 
 #include "polycube/mesh.h"
