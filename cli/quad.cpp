@@ -173,8 +173,17 @@ nlohmann::json quality_json(const QuadQuality& q) {
 // quads placed on it by its projector).
 struct QuadModel {
   const TriMesh* mesh = nullptr;
-  std::shared_ptr<const SurfaceProjector> projector;
+  const TriMesh* sampled = nullptr;  // the model as read, when mesh is its split copy
   bool split = false;
+  // Built on first use: the model as read's is needed only when a search runs on it (or --map).
+  std::shared_ptr<const SurfaceProjector> projector() const {
+    if (!projector_)
+      projector_ = sampled ? std::make_shared<const SurfaceProjector>(*mesh, *sampled) : std::make_shared<const SurfaceProjector>(*mesh);
+    return projector_;
+  }
+
+ private:
+  mutable std::shared_ptr<const SurfaceProjector> projector_;
 };
 
 // One orientation's map stages and its quads (those the orientation search built come with it).
@@ -226,10 +235,12 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // kept 11.5 deg mean angle deviation, not 3.0) and fitted to and measured against the model as
   // read (its vertices and points along its long edges: sampled by the split model's vertices,
   // pyramid's fit and refinement took 17 and 109 s).
-  const QuadModel as_read{&prepared.mesh, std::make_shared<const SurfaceProjector>(prepared.mesh), false};
-  const QuadModel split_model =
-      split.rounds > 0 ? QuadModel{&split.mesh, std::make_shared<const SurfaceProjector>(split.mesh, prepared.mesh), true} : as_read;
-  const std::shared_ptr<const SurfaceProjector>& projector = as_read.projector;
+  QuadModel as_read, split_copy;
+  as_read.mesh = &prepared.mesh;
+  split_copy.mesh = &split.mesh;
+  split_copy.sampled = &prepared.mesh;
+  split_copy.split = true;
+  const QuadModel& split_model = split.rounds > 0 ? split_copy : as_read;
 
   nlohmann::json report;
   report["input"] = diagnosis_json(prepared);
@@ -272,6 +283,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   std::vector<std::unique_ptr<QuadAttempt>> attempts;
   if (!options.map_dir.empty()) {
     progress.stage("map", "reading " + options.map_dir);
+    const std::shared_ptr<const SurfaceProjector> projector = as_read.projector();
     from_directory = read_map_directory(options.map_dir, projector, progress);
     auto a = std::make_unique<QuadAttempt>();
     a->name = options.map_dir;
@@ -321,7 +333,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   const auto remesh_with = [&](QuadAttempt& a) {
     const double start = progress.elapsed_seconds();
     a.aligned = rotated(*a.on->mesh, a.rotation);
-    const std::shared_ptr<const SurfaceProjector>& projector = a.on->projector;
+    const std::shared_ptr<const SurfaceProjector> projector = a.on->projector();
     progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
     if (!a.topology) a.topology = std::make_shared<TopologyResult>(analyse_topology(a.aligned, options.topology));
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
@@ -548,7 +560,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     report["quality"] = quality_json(q);
     // Where the flipped and degenerate quads are (the first 20), to find them in a viewer.
     nlohmann::json bad = nlohmann::json::array();
-    for (int b : bad_quads(result.mesh, *kept->on->projector, remesh.quality)) {
+    for (int b : bad_quads(result.mesh, *kept->on->projector(), remesh.quality)) {
       if (bad.size() == 20) break;
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
       for (int k = 0; k < 4; ++k) centre += result.mesh.V.row(result.mesh.Q(b, k)).transpose() / 4;
