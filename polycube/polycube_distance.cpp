@@ -1,5 +1,6 @@
 #include "polycube/polycube_distance.h"
 
+#include "polycube/parallel.h"
 #include "polycube/triangle_tree.h"
 
 #include <algorithm>
@@ -56,8 +57,12 @@ OneSided one_sided(const TriMesh& from, const TriMesh& to, const HausdorffOption
   OneSided result;
   double sum = 0;
   const std::vector<Point> samples = samples_of(from, options.samples, options.seed);
-  for (const Point& p : samples) {
-    const double d = std::sqrt(tree.squared_distance(p));
+  std::vector<double> distance(samples.size());
+  parallel_range(static_cast<int>(samples.size()), options.threads,
+                 [&](int k) { distance[k] = std::sqrt(tree.squared_distance(samples[k])); });
+  for (size_t k = 0; k < samples.size(); ++k) {
+    const Point& p = samples[k];
+    const double d = distance[k];
     if (d > result.largest) {
       result.largest = d;
       result.farthest = {p.x(), p.y(), p.z()};

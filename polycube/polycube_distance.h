@@ -13,6 +13,9 @@ struct HausdorffOptions {
   int samples = 20000;
   // Seed of the sampler (the result is deterministic for a seed).
   unsigned seed = 1;
+  // Threads for the distance queries (0: one per hardware thread); the result does not depend on
+  // it.
+  int threads = 0;
 };
 
 // Distances between the surfaces of a and b (input units).

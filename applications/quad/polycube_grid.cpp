@@ -3,6 +3,7 @@
 #include "applications/quad/surface_projector.h"
 #include "polycube/disjoint_sets.h"
 #include "polycube/errors.h"
+#include "polycube/parallel.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
@@ -498,15 +499,22 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
   // Points of P as surface points: the closest triangle (distance 0 up to rounding), with
   // barycentric coordinates in its plane.
   const SurfaceProjector on_p(mesh);
-  const auto surface_point = [&](const Eigen::Vector3d& p) {
+  const auto off_p = [&](const Eigen::Vector3d& p, double distance) {
+    return AlgorithmError("grid point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " + std::to_string(p.z()) +
+                          ") is " + std::to_string(distance) + " away from P");
+  };
+  // A point too far from P gets face -1 (`distance` set): the callers, on several threads, throw
+  // off_p for the first such point in order.
+  const auto try_surface_point = [&](const Eigen::Vector3d& p, double& distance) {
     const SurfaceHit hit = on_p.closest(p);
-    if (hit.distance > 1e-6 * diagonal)
-      throw AlgorithmError("grid point (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " +
-                           std::to_string(p.z()) + ") is " + std::to_string(hit.distance) + " away from P");
+    SurfacePoint point;
+    if (hit.distance > 1e-6 * diagonal) {
+      distance = hit.distance;
+      return point;
+    }
     const int a = labels[hit.face].axis;
     const std::array<Eigen::Vector2d, 3> t = triangle_2d(mesh, hit.face, a);
     const Eigen::Vector3d bary = barycentric_2d({p[(a + 1) % 3], p[(a + 2) % 3]}, t[0], t[1], t[2]).cwiseMax(0.0);
-    SurfacePoint point;
     point.face = hit.face;
     point.bary = bary / bary.sum();
     return point;
@@ -517,19 +525,32 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
     grid.sized_through_map = true;
     const int ne = static_cast<int>(edges.ends.size());
     const int samples = static_cast<int>(std::clamp<long long>(400000 / std::max(1, ne), 1, 8));
-    std::vector<double> measured(num_chords, 0);
-    for (int k = 0; k < ne; ++k) {
+    // Each edge's length through the map on the threads; then, in order, the checks and maxima.
+    std::vector<double> edge_length(ne, 0), off(ne, 0);
+    std::vector<Eigen::Vector3d> off_point(ne);
+    parallel_range(ne, options.threads, [&](int k) {
       const Eigen::Vector3d a = level_point(level_index[edges.ends[k][0]]), b = level_point(level_index[edges.ends[k][1]]);
       double length = 0;
-      Eigen::Vector3d previous = size_map(surface_point(a));
-      for (int i = 1; i <= samples; ++i) {
-        const Eigen::Vector3d next = size_map(surface_point(i == samples ? b : (a + (b - a) * (static_cast<double>(i) / samples)).eval()));
-        length += (next - previous).norm();
+      Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+      for (int i = 0; i <= samples; ++i) {
+        const Eigen::Vector3d x = i == 0 ? a : i == samples ? b : (a + (b - a) * (static_cast<double>(i) / samples)).eval();
+        const SurfacePoint point = try_surface_point(x, off[k]);
+        if (point.face < 0) {
+          off_point[k] = x;
+          return;
+        }
+        const Eigen::Vector3d next = size_map(point);
+        if (i > 0) length += (next - previous).norm();
         previous = next;
       }
-      if (!std::isfinite(length)) throw AlgorithmError("the map sends a layout edge of P to non-finite points");
+      edge_length[k] = length;
+    });
+    std::vector<double> measured(num_chords, 0);
+    for (int k = 0; k < ne; ++k) {
+      if (off[k] > 0) throw off_p(off_point[k], off[k]);
+      if (!std::isfinite(edge_length[k])) throw AlgorithmError("the map sends a layout edge of P to non-finite points");
       double& m = measured[chord_of[2 * edges.edge_quad[k][0] + edges.edge_side[k][0] % 2]];
-      m = std::max(m, length);
+      m = std::max(m, edge_length[k]);
     }
     for (int c = 0; c < num_chords; ++c) width[c] = std::max(measured[c], 1e-12 * width[c]);
   }
@@ -779,7 +800,10 @@ PolycubeGrid build_polycube_grid(const TriMesh& polycube, const PolycubeGridOpti
 
   // 7. Each vertex as a point of P.
   grid.on_polycube.resize(nv);
-  for (int v = 0; v < nv; ++v) grid.on_polycube[v] = surface_point(grid.mesh.V.row(v).transpose());
+  std::vector<double> off(nv, 0);
+  parallel_range(nv, options.threads, [&](int v) { grid.on_polycube[v] = try_surface_point(grid.mesh.V.row(v).transpose(), off[v]); });
+  for (int v = 0; v < nv; ++v)
+    if (off[v] > 0) throw off_p(grid.mesh.V.row(v).transpose(), off[v]);
 
   // 8. Corners: P's cone points, each a grid vertex (a layout corner).
   std::vector<std::pair<int, int>> corners;

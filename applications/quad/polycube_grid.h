@@ -67,6 +67,10 @@ struct PolycubeGridOptions {
   // More quads than this (0: no limit) stops the refinement before the point that would exceed
   // it; the points are taken in order, so put the most important first.
   long long refine_max_quads = 0;
+  // Threads for locating points on P and sizing chords through the map (0: one per hardware
+  // thread; the map must then be callable from several threads at once); the grid does not
+  // depend on it.
+  int threads = 0;
 };
 
 // The grid on P.

@@ -1,5 +1,7 @@
 #include "applications/quad/quad_quality.h"
 
+#include "polycube/parallel.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -41,11 +43,14 @@ std::vector<int> bad_quads(const QuadMesh& quads, const SurfaceProjector& refere
   const double diagonal = bounding_box(reference.surface().V).diagonal();
   const double min_length = options.degenerate_tolerance * diagonal;
   const double min_area = min_length * diagonal;
-  std::vector<int> out;
-  for (int q = 0; q < quads.num_quads(); ++q) {
+  std::vector<char> bad(quads.num_quads(), 0);
+  parallel_range(quads.num_quads(), options.threads, [&](int q) {
     const QuadCheck c = check_quad(quads, q, reference, min_length, min_area);
-    if (c.flipped || c.degenerate) out.push_back(q);
-  }
+    bad[q] = c.flipped || c.degenerate;
+  });
+  std::vector<int> out;
+  for (int q = 0; q < quads.num_quads(); ++q)
+    if (bad[q]) out.push_back(q);
   return out;
 }
 
@@ -72,11 +77,16 @@ QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& referen
   const double min_length = options.degenerate_tolerance * r.diagonal;
   const double min_area = options.degenerate_tolerance * r.diagonal * r.diagonal;
   double aspect_sum = 0;
-  for (int v = 0; v < r.vertices; ++v)
-    if (r.topology.valence[v] > 0)
-      r.max_distance_to_surface = std::max(r.max_distance_to_surface, reference.closest(quads.V.row(v).transpose()).distance);
+  // The closest points (the slow part) on the threads, then everything summed in order.
+  std::vector<double> vertex_distance(r.vertices, 0);
+  parallel_range(r.vertices, options.threads, [&](int v) {
+    if (r.topology.valence[v] > 0) vertex_distance[v] = reference.closest(quads.V.row(v).transpose()).distance;
+  });
+  for (double d : vertex_distance) r.max_distance_to_surface = std::max(r.max_distance_to_surface, d);
+  std::vector<QuadCheck> checks(r.quads);
+  parallel_range(r.quads, options.threads, [&](int q) { checks[q] = check_quad(quads, q, reference, min_length, min_area); });
   for (int q = 0; q < r.quads; ++q) {
-    const QuadCheck c = check_quad(quads, q, reference, min_length, min_area);
+    const QuadCheck& c = checks[q];
     const Eigen::Vector3d* p = c.p;
     r.flipped_quads += c.flipped;
     r.degenerate_quads += c.degenerate;
@@ -105,7 +115,9 @@ QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& referen
   }
 
   if (options.hausdorff && r.quads > 0) {
-    const HausdorffDistance d = hausdorff_distance(triangulate_quads(quads), reference.sampled(), options.sampling);
+    HausdorffOptions sampling = options.sampling;
+    sampling.threads = options.threads;
+    const HausdorffDistance d = hausdorff_distance(triangulate_quads(quads), reference.sampled(), sampling);
     r.hausdorff_measured = true;
     r.hausdorff = d.hausdorff;
     r.hausdorff_percent = r.diagonal > 0 ? 100 * d.hausdorff / r.diagonal : 0;

@@ -17,6 +17,9 @@ struct QuadQualityOptions {
   // A quad is degenerate when its area or an edge is below this times the reference's diagonal
   // (squared for the area).
   double degenerate_tolerance = 1e-10;
+  // Threads for the closest points and the Hausdorff samples (0: one per hardware thread); the
+  // figures do not depend on it.
+  int threads = 0;
 };
 
 // Everything measured (angles in degrees, lengths in input units).

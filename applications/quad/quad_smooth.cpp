@@ -94,8 +94,9 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   // Closest surface point of each vertex (its normal: the tangent plane moves stay in) and of
   // each quad's centre (the quad's surface normal, as quad_surface_normal finds it), kept as
   // search hints for the next queries nearby.
+  const int threads = std::max(1, options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
   std::vector<SurfaceHit> vertex_hit(nv);
-  for (int v = 0; v < nv; ++v) vertex_hit[v] = surface.closest(mesh.V.row(v).transpose());
+  parallel_range(nv, threads, [&](int v) { vertex_hit[v] = surface.closest(mesh.V.row(v).transpose()); });
   std::vector<SurfaceHit> quad_hit(mesh.num_quads());
   double size = mean_quad_size(mesh);
 
@@ -186,7 +187,7 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
     return p + offset.real() * t1 + offset.imag() * t2;
   };
 
-  for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
+  parallel_range(mesh.num_quads(), threads, [&](int q) { quad_state[q] = guard.state(q, quad_hit[q], size); });
 
   // One Gauss–Seidel move of v; returns how far it moved (-1: refused, 0: nothing to do). Reads
   // the vertices of v's quads, writes v and v's quads' states.
@@ -291,7 +292,6 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   // quads): colour by colour, each colour split over the threads. The result does not depend on
   // the number of threads.
   const std::vector<std::vector<int>> colours = quad_star_colours(mesh.Q, around, pinned);
-  const int threads = std::max(1, options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
   std::vector<Scratch> scratch(threads);
   struct Tally {
     long long moves = 0, rejected = 0;
@@ -419,7 +419,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
   double size = mean_quad_size(mesh);
   std::vector<SurfaceHit> quad_hit(mesh.num_quads());
   std::vector<int> quad_state(mesh.num_quads());
-  for (int q = 0; q < mesh.num_quads(); ++q) quad_state[q] = guard.state(q, quad_hit[q], size);
+  parallel_range(mesh.num_quads(), options.threads, [&](int q) { quad_state[q] = guard.state(q, quad_hit[q], size); });
 
   // The model's points to fit (vertices, centroids of long triangles, points along long edges a
   // quarter of the mean quad size apart: creases of a coarse CAD mesh; the vertices alone when
@@ -435,7 +435,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     const SurfaceProjector triangles(triangulate_quads(mesh));
     for (auto& list : owned) list.clear();
     // Exact for the points beyond the tolerance (which points are far is exact), walks elsewhere.
-    const std::vector<SurfaceHit> hits = closest_to_samples(triangles, model, samples, tolerance);
+    const std::vector<SurfaceHit> hits = closest_to_samples(triangles, model, samples, tolerance, options.threads);
     for (int w = 0; w < np; ++w) {
       const SurfaceHit& hit = hits[w];
       distance[w] = hit.distance;

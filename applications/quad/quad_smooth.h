@@ -116,6 +116,9 @@ struct QuadFitOptions {
   // over all the quads moved, and each of them ends within the tolerance of the model, within
   // half the point's distance, or no farther off than before). 0: such points are left.
   int stretch_rings = 8;
+  // Threads for the closest points of the model's points and of the quads (0: one per hardware
+  // thread); the pulls themselves run in order, so the result does not depend on it.
+  int threads = 0;
 };
 
 //   mesh       the fitted quads (same connectivity)

@@ -253,7 +253,11 @@ std::vector<SurfaceHit> closest_to_samples(const SurfaceProjector& surface, cons
   std::vector<SurfaceHit> hits = closest_to_vertices(surface, sampled, true);
   const int nv = sampled.num_vertices(), n = static_cast<int>(samples.points.size());
   hits.resize(n);
-  for (int k = nv; k < n; ++k) hits[k] = surface.closest_on_sheet(samples.points[k], hits[samples.hint_vertex[k]]);
+  // Each point's walk starts from its vertex's (done above): independent of each other.
+  parallel_range(n - nv, threads, [&](int i) {
+    const int k = nv + i;
+    hits[k] = surface.closest_on_sheet(samples.points[k], hits[samples.hint_vertex[k]]);
+  });
   parallel_range(n, threads, [&](int k) {
     if (!(hits[k].distance <= exact_beyond)) hits[k] = surface.closest(samples.points[k], hits[k]);
   });
