@@ -194,30 +194,49 @@ SurfaceHit SurfaceProjector::Impl::hit(const Eigen::Vector3d& query, const Eigen
   return hit;
 }
 
-std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, const TriMesh& points, bool on_sheet) {
+std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, const TriMesh& points, bool on_sheet, int threads) {
   const int n = points.num_vertices();
   std::vector<SurfaceHit> hits(n);
+  // The breadth-first order first (each vertex's hint: the vertex it was reached from; each
+  // component's first vertex searched without one), then the searches depth by depth, each
+  // depth's on the threads: every hint is a result of the depth before, so the answers are those
+  // of the searches made one after the other.
   const CompressedLists ring = vertex_faces(points.F, n);
-  std::vector<char> seen(n, 0);
-  std::vector<int> queue;
-  queue.reserve(n);
+  std::vector<int> parent(n, -1), depth(n, -1), order;
+  order.reserve(n);
+  int deepest = 0;
   for (int root = 0; root < n; ++root) {
-    if (seen[root]) continue;
-    seen[root] = 1;
-    hits[root] = surface.closest(points.V.row(root).transpose());
-    queue.assign(1, root);
-    for (size_t head = 0; head < queue.size(); ++head) {
-      const int v = queue[head];
+    if (depth[root] >= 0) continue;
+    depth[root] = 0;
+    const size_t first = order.size();
+    order.push_back(root);
+    for (size_t head = first; head < order.size(); ++head) {
+      const int v = order[head];
       for (const int* f = ring.first(v); f != ring.last(v); ++f)
         for (int i = 0; i < 3; ++i) {
           const int w = points.F(*f, i);
-          if (seen[w]) continue;
-          seen[w] = 1;
-          const Eigen::Vector3d x = points.V.row(w);
-          hits[w] = on_sheet ? surface.closest_on_sheet(x, hits[v]) : surface.closest(x, hits[v]);
-          queue.push_back(w);
+          if (depth[w] >= 0) continue;
+          depth[w] = depth[v] + 1;
+          deepest = std::max(deepest, depth[w]);
+          parent[w] = v;
+          order.push_back(w);
         }
     }
+  }
+  std::vector<std::vector<int>> at_depth(deepest + 1);
+  for (int v : order) at_depth[depth[v]].push_back(v);
+  // A depth with few vertices is not worth the threads' start.
+  constexpr int kParallelFrom = 512;
+  for (const std::vector<int>& level : at_depth) {
+    const auto search = [&](int k) {
+      const int w = level[k];
+      const Eigen::Vector3d x = points.V.row(w);
+      hits[w] = parent[w] < 0 ? surface.closest(x)
+                : on_sheet    ? surface.closest_on_sheet(x, hits[parent[w]])
+                              : surface.closest(x, hits[parent[w]]);
+    };
+    const int count = static_cast<int>(level.size());
+    parallel_range(count, count >= kParallelFrom ? threads : 1, search);
   }
   return hits;
 }
@@ -250,7 +269,7 @@ SurfaceSamples sample_surface(const TriMesh& surface, double spacing) {
 
 std::vector<SurfaceHit> closest_to_samples(const SurfaceProjector& surface, const TriMesh& sampled, const SurfaceSamples& samples,
                                            double exact_beyond, int threads) {
-  std::vector<SurfaceHit> hits = closest_to_vertices(surface, sampled, true);
+  std::vector<SurfaceHit> hits = closest_to_vertices(surface, sampled, true, threads);
   const int nv = sampled.num_vertices(), n = static_cast<int>(samples.points.size());
   hits.resize(n);
   // Each point's walk starts from its vertex's (done above): independent of each other.

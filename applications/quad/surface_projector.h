@@ -67,8 +67,10 @@ class SurfaceProjector {
 // The closest points on `surface` of all of `points`' vertices, each search starting from a
 // neighbour's result (breadth-first over points' triangles): exact (the hinted search of
 // SurfaceProjector::closest, the same answers as without hints, faster) or, with on_sheet, the
-// walks of closest_on_sheet alone (never nearer than the exact answer; many times faster).
-std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, const TriMesh& points, bool on_sheet);
+// walks of closest_on_sheet alone (never nearer than the exact answer; many times faster). The
+// searches of one breadth-first depth run on `threads` threads (0: one per hardware thread); the
+// answers do not depend on it.
+std::vector<SurfaceHit> closest_to_vertices(const SurfaceProjector& surface, const TriMesh& points, bool on_sheet, int threads = 1);
 
 // Points of a surface a coarser mesh on it must come near: its vertices first (point v is vertex
 // v), then the centroids of its triangles longer than `spacing` and points along its edges longer
