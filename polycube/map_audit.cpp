@@ -1,5 +1,6 @@
 #include "polycube/map_audit.h"
 
+#include "polycube/parallel.h"
 #include "polycube/target_surface.h"
 
 #include <Eigen/Geometry>
@@ -45,36 +46,44 @@ MapDirectionAudit audit_map_direction(const TriMesh& source, const Eigen::Matrix
   const double target_area = surface.area();
   const double diagonal = surface.diagonal();
 
-  // Closest target face of every image vertex (-1 when the vertex is not finite).
+  // Closest target face of every image vertex (-1 when the vertex is not finite), and each
+  // triangle's verdict, on the threads; then counted and summed in order.
   MapDirectionAudit audit;
   audit.triangles = source.num_faces();
   std::vector<int> vertex_face(nv, -1);
-  for (int v = 0; v < nv; ++v) {
-    if (!image.row(v).allFinite()) {
-      audit.max_distance = std::numeric_limits<double>::infinity();
-      continue;
-    }
+  std::vector<double> vertex_distance(nv, std::numeric_limits<double>::infinity());
+  parallel_range(nv, options.threads, [&](int v) {
+    if (!image.row(v).allFinite()) return;
     const auto [face, distance] = surface.closest(row(image, v));
     vertex_face[v] = face;
-    audit.max_distance = std::max(audit.max_distance, diagonal > 0 ? distance / diagonal : distance);
-  }
+    vertex_distance[v] = diagonal > 0 ? distance / diagonal : distance;
+  });
+  for (int v = 0; v < nv; ++v) audit.max_distance = std::max(audit.max_distance, vertex_distance[v]);
 
-  double image_area = 0;
-  for (int f = 0; f < source.num_faces(); ++f) {
+  // Per face: -1 a corner not finite; else the verdict (0 good, 1 flipped, 2 degenerate).
+  const int nf = source.num_faces();
+  std::vector<int> verdict(nf, -1);
+  std::vector<double> area(nf, 0);
+  parallel_range(nf, options.threads, [&](int f) {
     const int corner[3] = {source.F(f, 0), source.F(f, 1), source.F(f, 2)};
-    if (vertex_face[corner[0]] < 0 || vertex_face[corner[1]] < 0 || vertex_face[corner[2]] < 0) {
-      ++audit.degenerate;
-      continue;
-    }
+    if (vertex_face[corner[0]] < 0 || vertex_face[corner[1]] < 0 || vertex_face[corner[2]] < 0) return;
     const Eigen::Vector3d a = row(image, corner[0]), b = row(image, corner[1]), c = row(image, corner[2]);
-    image_area += 0.5 * (b - a).cross(c - a).norm();
+    area[f] = 0.5 * (b - a).cross(c - a).norm();
     // The target's outward normal near the triangle: the distinct faces closest to its centroid
     // and to its corners, area-weighted. Across a polycube edge the corners find both faces, and
     // a correctly oriented chord has a positive dot product with each of them.
     // (image_orientation.h: the faces nearest the centroid and corners, then a finer look.)
-    const int verdict = surface.judge(a, b, c, vertex_face[corner[0]], vertex_face[corner[1]], vertex_face[corner[2]]);
-    audit.degenerate += verdict == 2;
-    audit.flipped += verdict == 1;
+    verdict[f] = surface.judge(a, b, c, vertex_face[corner[0]], vertex_face[corner[1]], vertex_face[corner[2]]);
+  });
+  double image_area = 0;
+  for (int f = 0; f < nf; ++f) {
+    if (verdict[f] < 0) {
+      ++audit.degenerate;
+      continue;
+    }
+    image_area += area[f];
+    audit.degenerate += verdict[f] == 2;
+    audit.flipped += verdict[f] == 1;
   }
   audit.area_ratio = image_area / target_area;
   audit.ok = audit.flipped == 0 && audit.degenerate == 0 && audit.max_distance <= options.surface_tolerance &&

@@ -23,6 +23,9 @@ struct MapAuditOptions {
   // on P, where each chord across a 90° edge loses (2 - √2)·w·L of P's area (w: how far its
   // corners are from the edge, L: its length along it).
   double area_tolerance = 0.02;
+  // Threads for the closest faces and the verdicts (0: one per hardware thread); the audit does
+  // not depend on it.
+  int threads = 0;
 };
 
 // One direction of the map: the triangles of a source mesh, placed at their vertices' images,

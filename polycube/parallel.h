@@ -55,16 +55,20 @@ int parallel_for_each(const std::vector<int>& order, int threads, const std::str
 }
 
 // Runs work(i) for i in [0, n) on `threads` threads (0: one per hardware thread), in 64
-// interleaved blocks; errors as parallel_for_each's (prefixed "block <k>: ").
+// contiguous blocks taken in turn (neighbouring items, often near in space, stay on one thread:
+// interleaved blocks made the audit's closest-face searches of gargoyle 20 % slower); errors as
+// parallel_for_each's (prefixed "block <k>: ").
 template <class Work>
 void parallel_range(int n, int threads, Work&& work) {
   if (n <= 0) return;
   constexpr int kBlocks = 64;
-  std::vector<int> blocks(std::min(kBlocks, n));
+  const int count = std::min(kBlocks, n);
+  std::vector<int> blocks(count);
   std::iota(blocks.begin(), blocks.end(), 0);
-  const int stride = static_cast<int>(blocks.size());
   parallel_for_each(blocks, threads, "block", [&](int block) {
-    for (int i = block; i < n; i += stride) work(i);
+    const int begin = static_cast<int>(static_cast<long long>(n) * block / count);
+    const int end = static_cast<int>(static_cast<long long>(n) * (block + 1) / count);
+    for (int i = begin; i < end; ++i) work(i);
   });
 }
 
