@@ -295,6 +295,28 @@ QuadRemeshResult remesh_horn(const QuadRemeshOptions& options) {
   return remesh_quads(h.P, h.radial, *h.model, options);
 }
 
+// Every stage's loops on threads write per item and sum in order: the same quads, to the last
+// bit, on one thread or three (the horn's refinement rounds, fit and relaxation included).
+TEST(QuadCarry, SameQuadsOnOneThreadOrThree) {
+  QuadRemeshOptions options = horn_options(1500, 2);
+  options.fit.stretch_rings = 8;
+  const auto with_threads = [&](int threads) {
+    QuadRemeshOptions o = options;
+    o.grid.threads = o.smooth.threads = o.fit.threads = o.carry.threads = o.refine.threads = o.quality.threads = threads;
+    o.quality.sampling.threads = threads;
+    return remesh_horn(o);
+  };
+  const QuadRemeshResult a = with_threads(1), b = with_threads(3);
+  EXPECT_GT(a.refine_rounds + a.template_rounds, 0) << "the comparison covers the refinement";
+  EXPECT_GT(a.fitting.snapped, 0) << "and the fit";
+  EXPECT_EQ(a.mesh.Q, b.mesh.Q);
+  EXPECT_EQ(a.mesh.V, b.mesh.V);
+  EXPECT_EQ(a.quality.hausdorff, b.quality.hausdorff);
+  EXPECT_EQ(a.quality.angle_deviation_mean, b.quality.angle_deviation_mean);
+  EXPECT_EQ(a.quality.max_distance_to_surface, b.quality.max_distance_to_surface);
+  EXPECT_EQ(a.quality.flipped_quads, b.quality.flipped_quads);
+}
+
 TEST(QuadCarry, RefinementReachesIntoAHorn) {
   QuadRemeshOptions options = horn_options(1500, 0);
   const QuadRemeshResult uniform = remesh_horn(options);

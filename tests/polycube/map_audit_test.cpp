@@ -258,6 +258,31 @@ TEST(MapAudit, SwappedImagesAreFlipped) {
   EXPECT_FALSE(inverse.ok);
 }
 
+// The audit runs its searches and verdicts on threads and counts them in order: the same audit
+// on one thread or several, to the last bit (a map with flips, images off the surface and
+// degenerate triangles, both directions).
+TEST(MapAudit, SameAuditOnOneThreadOrSeveral) {
+  const TriMesh torus = test::make_torus(3, 1, 48, 24);
+  Eigen::MatrixX3d image = torus.V;
+  for (int f = 0; f < torus.num_faces(); f += 97) image.row(torus.F(f, 0)).swap(image.row(torus.F(f, 1)));
+  for (int v = 5; v < torus.num_vertices(); v += 131) image.row(v) *= 1.01;
+  image.row(torus.F(3, 1)) = image.row(torus.F(3, 0));
+  MapAuditOptions one, several;
+  one.threads = 1;
+  several.threads = 3;
+  const MapAudit a = audit_map(torus, torus, image, image, one), b = audit_map(torus, torus, image, image, several);
+  EXPECT_GT(a.polycube_to_model.flipped, 0);
+  EXPECT_GT(a.polycube_to_model.degenerate, 0);
+  EXPECT_GT(a.polycube_to_model.max_distance, 0);
+  for (const auto& [x, y] : {std::make_pair(a.polycube_to_model, b.polycube_to_model), std::make_pair(a.model_to_polycube, b.model_to_polycube)}) {
+    EXPECT_EQ(x.flipped, y.flipped);
+    EXPECT_EQ(x.degenerate, y.degenerate);
+    EXPECT_EQ(x.max_distance, y.max_distance);
+    EXPECT_EQ(x.area_ratio, y.area_ratio);
+    EXPECT_EQ(x.ok, y.ok);
+  }
+}
+
 TEST(MapAudit, ImageTriangleAcrossTheSolidCountsAsFlipped) {
   // A triangle with two corners on the top face and one on the bottom face of the cube stands in
   // the plane y = 2: its normal is tangent to every face it is near (dot product exactly 0), so
