@@ -1,6 +1,7 @@
 #include "cli/commands.h"
 
 #include "polycube/errors.h"
+#include "polycube/parallel.h"
 
 #include <cstdio>
 #include <iomanip>
@@ -41,6 +42,9 @@ int run(int argc, char** argv) {
   app.fallthrough();  // global options also after the subcommand: `polycube inspect m.obj --quiet`
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "No progress or warnings on stderr");
+  app.add_option("--threads", global.threads,
+                 "Most threads each parallel step uses (0: one per hardware thread); the results do not depend on it")
+      ->check(CLI::Range(0, 1024));
   CommandRunner runner;
   add_inspect_command(app, global, runner);
   add_map_command(app, global, runner);
@@ -62,6 +66,7 @@ int run(int argc, char** argv) {
     return fail(kUsageError, std::string(e.what()) + " (see polycube --help)");
   }
 
+  thread_limit() = global.threads;
   try {
     return runner();
   } catch (const InputError& e) {

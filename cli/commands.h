@@ -23,6 +23,7 @@ enum ExitCode : int {
 // Options every subcommand shares.
 struct GlobalOptions {
   bool quiet = false;
+  int threads = 0;  // most threads per parallel step (0: one per hardware thread)
 };
 
 // Stage progress on stderr: "[  1.23 s] stage: message". Silent with --quiet.

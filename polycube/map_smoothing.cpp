@@ -438,7 +438,7 @@ class ForwardMap {
   // edges apart (nothing one move reads is written by another), so they move in parallel and the
   // result does not depend on the number of threads. Returns the number of accepted moves.
   int sweep(const std::vector<std::vector<int>>& colours, int threads, int& rejected) {
-    const int nthreads = threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    const int nthreads = threads_for(threads);
     if (scratch_.size() < static_cast<size_t>(nthreads)) scratch_.resize(nthreads);
     int moves = 0;
     for (const std::vector<int>& colour : colours) {
@@ -685,7 +685,7 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
   }
   missed.assign(M.mesh().num_vertices(), 0);
   // One part per thread (each with its chart's work space), vertices interleaved.
-  const int nthreads = threads > 0 ? threads : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int nthreads = threads_for(threads);
   std::vector<int> parts(nthreads);
   std::iota(parts.begin(), parts.end(), 0);
   parallel_for_each(parts, nthreads, "part", [&](int part) {

@@ -14,8 +14,23 @@
 
 namespace polycube {
 
+// The process-wide most threads one parallel step may use (0: no limit); the CLI's --threads.
+// Steps run inside another step's items (the orientation candidates' maps, each mapping its
+// pieces) can together use this many per outer thread.
+inline std::atomic<int>& thread_limit() {
+  static std::atomic<int> limit{0};
+  return limit;
+}
+
+// How many threads a request for `threads` gets (0: one per hardware thread), within the limit.
+inline int threads_for(int threads) {
+  if (threads <= 0) threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int limit = thread_limit().load();
+  return limit > 0 ? std::min(threads, limit) : threads;
+}
+
 // Calls work(i) for every i in `order` (largest items first is best), on `threads` threads (0:
-// one per hardware thread), at most one thread per item. If items throw, rethrows the error of
+// one per hardware thread; see threads_for), at most one thread per item. If items throw, rethrows the error of
 // the smallest such i, a MeshError or AlgorithmError with its message prefixed by
 // "<what> <i>: ". Returns the number of threads used.
 template <class Work>
@@ -34,8 +49,7 @@ int parallel_for_each(const std::vector<int>& order, int threads, const std::str
       }
     }
   };
-  if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::clamp(threads, 1, std::max(1, n));
+  threads = std::clamp(threads_for(threads), 1, std::max(1, n));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(run);
   run();

@@ -2,6 +2,7 @@
 
 #include "polycube/closest_point.h"
 #include "polycube/errors.h"
+#include "polycube/parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -22,7 +23,7 @@ QuadMesh carry_grid(const PolycubeGrid& grid, const SurfaceMap& map, const Carry
   mesh.Q = grid.mesh.Q;
   const int nv = grid.mesh.num_vertices();
   mesh.V.resize(nv, 3);
-  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  int threads = threads_for(options.threads);
   threads = std::max(1, std::min(threads, nv / 256 + 1));
 
   std::atomic<int> next{0};

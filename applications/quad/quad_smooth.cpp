@@ -94,7 +94,7 @@ QuadSmoothResult smooth_quads(const QuadMesh& quads, const SurfaceProjector& sur
   // Closest surface point of each vertex (its normal: the tangent plane moves stay in) and of
   // each quad's centre (the quad's surface normal, as quad_surface_normal finds it), kept as
   // search hints for the next queries nearby.
-  const int threads = std::max(1, options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency()));
+  const int threads = threads_for(options.threads);
   std::vector<SurfaceHit> vertex_hit(nv);
   parallel_range(nv, threads, [&](int v) { vertex_hit[v] = surface.closest(mesh.V.row(v).transpose()); });
   std::vector<SurfaceHit> quad_hit(mesh.num_quads());

@@ -90,6 +90,27 @@ TEST(QuadCli, MapBuiltInMemory) {
   EXPECT_EQ(t.genus(), 2);
 }
 
+// --threads bounds every parallel step; the quads and the report's figures do not depend on it
+// (eight at 2000 quads: the orientation search's maps and audits, the relaxation, the fit and the
+// refinement all run; one thread against three).
+TEST(QuadCli, SameQuadsOnOneThreadOrThree) {
+  const std::string dir = test::temp_dir("quad-cli");
+  const auto run_with = [&](int threads) {
+    const std::string out = dir + "/t" + std::to_string(threads) + ".obj", report = dir + "/t" + std::to_string(threads) + ".json";
+    const test::CliRun run = polycube_cli("quad " + quoted(test::data_path("eight.off")) + " -o " + quoted(out) + " --report " +
+                                          quoted(report) + " --target-faces 2000 --quiet --threads " + std::to_string(threads));
+    EXPECT_EQ(run.code, 0) << run.err;
+    return std::make_pair(test::read_file(out), nlohmann::json::parse(test::read_file(report)));
+  };
+  const auto [one, one_report] = run_with(1);
+  const auto [three, three_report] = run_with(3);
+  EXPECT_FALSE(one.empty());
+  EXPECT_EQ(one, three) << "the quads written differ";
+  EXPECT_EQ(one_report["quality"], three_report["quality"]);
+  EXPECT_EQ(one_report["grid"], three_report["grid"]);
+  EXPECT_EQ(polycube_cli("quad " + quoted(test::data_path("eight.off")) + " -o " + quoted(dir + "/q.obj") + " --threads -1").code, 2);
+}
+
 // Quads that fall short (a flipped quad, or more than 1 % of the diagonal from the model) try the
 // orientation search's next candidates, and the best are written: elephant at 3000 quads without
 // refinement, whose winner's quads have a flipped quad and miss the model by 1.4 % of the
