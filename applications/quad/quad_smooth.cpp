@@ -465,6 +465,16 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     for (const Eigen::Vector3d& y : samples) off = std::max(off, surface.closest(y, quad_hit[q]).distance);
     return off;
   };
+  // quad_off of quads as they are before a move, kept until one of their corners moves (a pull
+  // tried and undone leaves them as they were: most pulls are refused).
+  std::vector<double> off_known(mesh.num_quads(), -1);
+  auto off_before = [&](int q) {
+    if (off_known[q] < 0) off_known[q] = quad_off(q);
+    return off_known[q];
+  };
+  auto forget_off = [&](const std::vector<int>& quads) {
+    for (int q : quads) off_known[q] = -1;
+  };
   auto off_model = [&](const std::vector<int>& quads) {
     double off = 0;
     for (int q : quads) off = std::max(off, quad_off(q));
@@ -561,7 +571,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     touched_off.clear();
-    for (int q : touched) touched_off.push_back(quad_off(q));
+    for (int q : touched) touched_off.push_back(off_before(q));
     region_old.clear();
     for (size_t i = 0; i < region.size(); ++i) {
       region_old.push_back(mesh.V.row(region[i]));
@@ -607,6 +617,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
       quad_state[touched[i]] = touched_state[i];
       quad_hit[touched[i]] = touched_hit[i];
     }
+    forget_off(touched);
     take_rechecked();
     for (int u : region) ring_of[u] = -1;
     distance[w] = 0;
@@ -641,7 +652,8 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
       for (int u : neighbours[v]) collapses |= (mesh.V.row(u).transpose() - x).norm() < kShortestEdge * size;
       if (collapses) continue;
       const Eigen::Vector3d old = mesh.V.row(v);
-      const double off_before = off_model(around[v]);
+      double off_around = 0;
+      for (int q : around[v]) off_around = std::max(off_around, off_before(q));
       mesh.V.row(v) = x;
       bool accepted = true;
       after.clear();
@@ -652,7 +664,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
         accepted = (quad_state[around[v][k]] & ~after.back()) == 0;
       }
       // Nor may v's quads move off the model: sampled, no farther than the tolerance or than before.
-      if (accepted) accepted = off_model(around[v]) <= std::max(tolerance, off_before);
+      if (accepted) accepted = off_model(around[v]) <= std::max(tolerance, off_around);
       // Nor may a corner of its quads bend farther from 90° than the limit (and than before).
       for (size_t k = 0; k < around[v].size() && accepted; ++k) {
         const int q = around[v][k];
@@ -678,6 +690,7 @@ QuadFitResult fit_quads(const QuadMesh& quads, const SurfaceProjector& surface, 
         quad_state[around[v][k]] = after[k];
         quad_hit[around[v][k]] = after_hit[k];
       }
+      forget_off(around[v]);
       take_rechecked();
       distance[w] = 0;
       result.pinned[v] = 1;
