@@ -6,13 +6,10 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
-#include <atomic>
 #include <exception>
-#include <mutex>
+#include <map>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -23,36 +20,22 @@ QuadMesh carry_grid(const PolycubeGrid& grid, const SurfaceMap& map, const Carry
   mesh.Q = grid.mesh.Q;
   const int nv = grid.mesh.num_vertices();
   mesh.V.resize(nv, 3);
-  int threads = threads_for(options.threads);
-  threads = std::max(1, std::min(threads, nv / 256 + 1));
-
-  std::atomic<int> next{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  const auto work = [&] {
+  // Each vertex on the threads; the error (the map's own, or a non-finite image) of the lowest
+  // failing vertex, whatever the threads.
+  std::vector<std::exception_ptr> error(nv);
+  parallel_range(nv, options.threads, [&](int v) {
     try {
-      for (int begin; (begin = next.fetch_add(256)) < nv;)
-        for (int v = begin; v < std::min(nv, begin + 256); ++v) {
-          const Eigen::Vector3d p = map(grid.on_polycube[v]);
-          if (!p.allFinite())
-            throw AlgorithmError("the map sends grid vertex " + std::to_string(v) + " (triangle " +
-                                 std::to_string(grid.on_polycube[v].face) + " of P) to a non-finite point");
-          mesh.V.row(v) = p;
-        }
+      const Eigen::Vector3d p = map(grid.on_polycube[v]);
+      if (!p.allFinite())
+        throw AlgorithmError("the map sends grid vertex " + std::to_string(v) + " (triangle " +
+                             std::to_string(grid.on_polycube[v].face) + " of P) to a non-finite point");
+      mesh.V.row(v) = p;
     } catch (...) {
-      const std::lock_guard<std::mutex> lock(failure_mutex);
-      if (!failure) failure = std::current_exception();
-      next = nv;
+      error[v] = std::current_exception();
     }
-  };
-  if (threads == 1) {
-    work();
-  } else {
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t) pool.emplace_back(work);
-    for (std::thread& t : pool) t.join();
-  }
-  if (failure) std::rethrow_exception(failure);
+  });
+  for (const std::exception_ptr& e : error)
+    if (e) std::rethrow_exception(e);
   return mesh;
 }
 

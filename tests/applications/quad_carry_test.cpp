@@ -152,6 +152,31 @@ TEST(QuadCarry, NonFiniteImageIsAnError) {
   const PolycubeGrid grid = build_polycube_grid(cube(), {});
   EXPECT_THROW(carry_grid(grid, [](const SurfacePoint&) { return Eigen::Vector3d(NAN, 0, 0); }), AlgorithmError);
   EXPECT_THROW(vertex_image_map(cube(), Eigen::MatrixX3d::Zero(3, 3)), std::invalid_argument);
+  // On several threads too, the error names the lowest failing vertex (the images of the grid's
+  // last half are not finite), not the one a thread happened to meet first.
+  const int nv = grid.mesh.num_vertices();
+  ASSERT_GT(nv, 100);
+  const auto vertex_at = [&](const SurfacePoint& p) {
+    for (int v = 0; v < nv; ++v)
+      if (grid.on_polycube[v].face == p.face && grid.on_polycube[v].bary == p.bary) return v;
+    return -1;
+  };
+  const int first_bad = nv / 2;
+  for (const int threads : {1, 3}) {
+    CarryOptions options;
+    options.threads = threads;
+    try {
+      carry_grid(grid, [&](const SurfacePoint& p) {
+        const int v = vertex_at(p);
+        if (v >= first_bad) return Eigen::Vector3d(NAN, 0, 0);
+        return Eigen::Vector3d(v, 0, 0);
+      }, options);
+      FAIL() << "no error";
+    } catch (const AlgorithmError& e) {
+      EXPECT_NE(std::string(e.what()).find("grid vertex " + std::to_string(first_bad) + " "), std::string::npos)
+          << e.what() << " (threads " << threads << ")";
+    }
+  }
 }
 
 // The cube carried onto a sphere by central projection: 8 irregular vertices of valence 3.
