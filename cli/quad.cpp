@@ -321,7 +321,12 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       progress.stage("align", alignment.candidates[alignment.chosen].name + suffix);
     }
     for (const AlignedStages& stages : alignment.stages_in_order()) {
+      // Every try but the very first is capped: a layout that alone needs half as many quads
+      // again as the refinement may reach is given up at once (3torus: an alternative's layout
+      // of 95 384 quads for 10 000 spent 80 s to miss by 3.3 %).
+      const bool capped = !attempts.empty() && options.cell_size <= 0;
       attempts.push_back(std::make_unique<QuadAttempt>());
+      if (capped) attempts.back()->max_quads = static_cast<long long>(1.5 * options.refine_bound_growth * options.target_faces);
       static_cast<AlignedStages&>(*attempts.back()) = stages;
       attempts.back()->name = (stages.candidate >= 0 ? alignment.candidates[stages.candidate].name : std::string("input frame")) + suffix;
       attempts.back()->polycube_options = polycube;
@@ -372,8 +377,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     return "the quads fall short (" + std::to_string(kept->bad()) + " flipped or degenerate, " +
            percent(kept->result->quality.hausdorff_percent) + " % Hausdorff); ";
   };
-  // A capped try (max_quads > 0) that fails is given up, one with more than refine_bound_growth
-  // × target_faces quads is not kept.
+  // A capped try (max_quads > 0: every try but the first, unless --cell-size) that fails is given
+  // up, one with more than refine_bound_growth × target_faces quads is not kept.
   const auto remesh_from = [&](size_t first) {
     for (size_t i = first; i < attempts.size(); ++i) {
       QuadAttempt& a = *attempts[i];
@@ -396,29 +401,23 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   remesh_from(0);
   // Another search for quads still short, with other polycube options. A finer P's layout can
   // need many more quads than asked (spool: 104 368 for 10 000, at 0.538 % against 0.705 %, 4
-  // minutes): such tries are capped (not kept above the growth the refinement may reach, given up
-  // when the grid alone is half as large again).
+  // minutes): its tries are capped as every try after the first (add_attempts).
   const auto search_again = [&](const PolycubeOptions& polycube, const std::string& key, const std::string& suffix,
-                                const std::string& what, const QuadModel& on, bool capped) {
+                                const std::string& what, const QuadModel& on) {
     progress.stage("retry", shortfall() + "all over again " + what);
     const size_t first = attempts.size();
     try {
       add_attempts(polycube, report["alignment"][key], suffix, on);
-      if (options.cell_size <= 0 && capped)
-        for (size_t i = first; i < attempts.size(); ++i)
-          attempts[i]->max_quads = static_cast<long long>(1.5 * options.refine_bound_growth * options.target_faces);
       remesh_from(first);
     } catch (const Error& e) {
       progress.warning(key + ": " + e.what());
     }
   };
-  // Still short, on the split model: the whole search again on the model as read (its own first
-  // search before the split, uncapped). The split is what CAD models need, but on coarse organic
+  // Still short, on the split model: the whole search again on the model as read. The split is what CAD models need, but on coarse organic
   // ones whose quads fall short (thin parts, folds) it was no better and sometimes worse (femur's
   // quads on the split model: 31 flipped and 2.42 %; on the model as read 1 and 1.37 %).
   if (kept->worth_retrying() && options.map_dir.empty() && split_model.split)
-    search_again(options.polycube, "model_as_read", ", model as read", "on the model as read (long edges not split)", as_read,
-                 false);
+    search_again(options.polycube, "model_as_read", ", model as read", "on the model as read (long edges not split)", as_read);
   // The later searches run on the model as read, then on the split model: so every search made
   // before the split still runs when the quads fall short (cow's best, 2.49 % and no flipped quad,
   // came from the model as read with finer contours; its split model's searches kept 7 flipped).
@@ -434,8 +433,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     finer.da = options.polycube.da / options.finer_contours;
     std::ostringstream suffix;
     suffix << ", finer contours (d_a " << finer.da << ")" << model_suffix(*on);
-    search_again(finer, model_key("finer_contours", *on), suffix.str(), "with d_a " + std::to_string(finer.da) + model_suffix(*on), *on,
-                 true);
+    search_again(finer, model_key("finer_contours", *on), suffix.str(), "with d_a " + std::to_string(finer.da) + model_suffix(*on), *on);
   }
   // Still short: once more keeping thin parts (a tail or a fin whose area is small beside its
   // section's, so d_a drops it from P and the map squeezes it; bull: 7.25 % -> 0.39 % of the
@@ -446,7 +444,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     thin.feature_distance = options.thin_parts;
     std::ostringstream suffix;
     suffix << ", thin parts kept (" << thin.feature_distance << ")" << model_suffix(*on);
-    search_again(thin, model_key("thin_parts", *on), suffix.str(), "keeping thin parts" + std::string(model_suffix(*on)), *on, true);
+    search_again(thin, model_key("thin_parts", *on), suffix.str(), "keeping thin parts" + std::string(model_suffix(*on)), *on);
   }
   if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;

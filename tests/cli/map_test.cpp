@@ -283,6 +283,50 @@ TEST(MapCli, TheLastUntanglingLeavesNoFlippedImageTriangle) {
   EXPECT_LE(untangled.at("max_shift").get<double>(), report.at("parameters").at("untangle_shift").get<double>());
 }
 
+// A coarse CAD model whose first untangling (moves within 1 % of the diagonal) leaves model
+// triangles flipped on P: mpi_triang turned y up, its map in that frame alone (no other
+// orientation, finer contours or exact sampling). With the wider runs turned off
+// (--untangle-shift-max equal to the shift) 3 stay flipped and `map` says that the map falls
+// short of its contract, in a warning and in the report, exit 0 with the files written; with the
+// default the run at a wider shift unfolds them and the map meets the contract.
+TEST(MapCli, AWiderUntanglingUnfoldsWhatTheFirstLeaves) {
+  const std::string base = "map --align none --finer-contours 1 --no-exact " + quoted(test::data_path("mpi_triang_y_up.off"));
+  const std::string narrow = test::temp_dir("map-untangle-narrow");
+  const CliRun short_run = polycube_cli(base + " --untangle-shift-max 0.01 -o " + quoted(narrow));
+  ASSERT_EQ(short_run.code, 0) << short_run.err;
+  const auto short_map = read_json(narrow + "/report.json").at("map");
+  EXPECT_GT(short_map.at("model_to_polycube").at("flipped").get<int>(), 0);
+  EXPECT_FALSE(short_map.at("meets_contract").get<bool>());
+  EXPECT_NE(short_run.err.find("warning: the map falls short of its contract:"), std::string::npos) << short_run.err;
+  EXPECT_NE(short_run.err.find("flipped or degenerate image triangles"), std::string::npos) << short_run.err;
+  EXPECT_TRUE(std::filesystem::exists(narrow + "/model_on_polycube.obj"));
+
+  const std::string wide = test::temp_dir("map-untangle-wide");
+  const CliRun run = polycube_cli(base + " -o " + quoted(wide));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(wide + "/report.json");
+  const auto& map = report.at("map");
+  EXPECT_TRUE(map.at("meets_contract").get<bool>());
+  EXPECT_EQ(run.err.find("falls short"), std::string::npos) << run.err;
+  for (const char* direction : {"polycube_to_model", "model_to_polycube"}) {
+    SCOPED_TRACE(direction);
+    EXPECT_EQ(map.at(direction).at("flipped").get<int>(), 0);
+    EXPECT_EQ(map.at(direction).at("degenerate").get<int>(), 0);
+  }
+  EXPECT_NEAR(map.at("polycube_to_model").at("area_ratio").get<double>(), 1.0, 0.02);
+  const auto& untangled = map.at("untangling").at("model_to_polycube");
+  EXPECT_GT(untangled.at("shift_allowed").get<double>(), report.at("parameters").at("untangle_shift").get<double>());
+  EXPECT_LE(untangled.at("shift_allowed").get<double>(), report.at("parameters").at("untangle_shift_max").get<double>());
+  EXPECT_EQ(untangled.at("bad_after").get<int>(), 0);
+  // The written files audit as reported.
+  const TriMesh model = test::load_mesh_file(test::data_path("mpi_triang_y_up.off"));
+  const TriMesh P = test::load_mesh_file(wide + "/polycube.obj");
+  const TriMesh on_polycube = test::load_mesh_file(wide + "/model_on_polycube.obj");
+  const MapDirectionAudit audit = audit_map_direction(model, on_polycube.V, P);
+  EXPECT_EQ(audit.flipped, 0);
+  EXPECT_EQ(audit.degenerate, 0);
+}
+
 // The exact sampling (map_overlay.h) when the finished map misses the contract: torus_quad's map
 // sampled at P's vertices only (no refinement, smoothing or untangling) flips P's triangles; the
 // overlay of both disk triangulations is kept instead, written with as many vertices and faces in
