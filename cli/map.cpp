@@ -233,32 +233,24 @@ std::string refinement_line(const MapRefinementResult& r) {
 // direction is still flipped or degenerate, single vertex images move on the target surface until
 // the audit passes there; then that direction's audit again. When moves within max_shift leave a
 // bad triangle, the untangling runs again from the map's images with 2, 5 and 10 times that
-// shift, up to shift_cap, while bad triangles remain; the run leaving the fewest is kept (the
-// earliest of equals). The greedy moves differ with the shift, so a larger one is not always
-// better (a coarse CAD model, mpi_triang: 3 left at 0.01, 2 at 0.02, 0 at 0.05, 1 at 0.1).
+// shift, up to shift_cap (ImageUntangleOptions::wider_shifts), while bad triangles remain; the
+// run leaving the fewest is kept. The greedy moves differ with the shift, so a larger one is not
+// always better (a coarse CAD model, mpi_triang: 3 left at 0.01, 2 at 0.02, 0 at 0.05, 1 at 0.1).
 void untangle_images(const TriMesh& model, Finished& out, double max_shift, double shift_cap, const Progress& progress) {
   if ((out.bad_p() == 0 && out.bad_m() == 0) || max_shift <= 0) return;
   const double start = progress.elapsed_seconds();
   progress.stage("untangle", std::to_string(out.bad_p()) + " / " + std::to_string(out.bad_m()) +
                                  " bad image triangles (P to M / M to P): moving single images");
   const TriMesh& P = out.polycube->mesh;
-  auto run = [max_shift, shift_cap](const TriMesh& source, Eigen::MatrixX3d& image, const TriMesh& target) {
-    ImageUntangleOptions options;
-    options.max_shift = max_shift;
-    ImageUntangleResult best = untangle_image(source, image, target, options);
-    double best_shift = max_shift;
-    for (const double factor : {2.0, 5.0, 10.0}) {
-      if (best.bad_after == 0 || factor * max_shift > shift_cap * (1 + 1e-12)) break;
-      options.max_shift = factor * max_shift;
-      ImageUntangleResult wider = untangle_image(source, image, target, options);
-      if (wider.bad_after < best.bad_after) {
-        best = std::move(wider);
-        best_shift = options.max_shift;
-      }
-    }
-    image = best.image;
-    return nlohmann::json{{"bad_before", best.bad_before}, {"bad_after", best.bad_after}, {"moved", best.moved},
-                          {"max_shift", best.max_shift}, {"shift_allowed", best_shift}};
+  ImageUntangleOptions options;
+  options.max_shift = max_shift;
+  for (const double factor : {2.0, 5.0, 10.0})
+    if (factor * max_shift <= shift_cap * (1 + 1e-12)) options.wider_shifts.push_back(factor * max_shift);
+  auto run = [&options](const TriMesh& source, Eigen::MatrixX3d& image, const TriMesh& target) {
+    const ImageUntangleResult result = untangle_image(source, image, target, options);
+    image = result.image;
+    return nlohmann::json{{"bad_before", result.bad_before}, {"bad_after", result.bad_after}, {"moved", result.moved},
+                          {"max_shift", result.max_shift}, {"shift_allowed", result.shift_allowed}};
   };
   out.untangling = nlohmann::json::object();
   // Only the direction moved is audited again (and the distortion, which P → M defines).

@@ -32,18 +32,26 @@ class Untangler {
  public:
   Untangler(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target, const ImageUntangleOptions& options)
       : source_(source), surface_(target, "untangle_image"), input_(image), image_(image), face_(source.num_vertices()),
-        star_(source.num_vertices()), bad_(source.num_faces()), room_(source.num_vertices()) {
+        star_(source.num_vertices()), bad_(source.num_faces()), room_(source.num_vertices()), shortest_(source.num_vertices()),
+        edge_share_(options.max_edge_share) {
     for (int v = 0; v < source.num_vertices(); ++v) face_[v] = surface_.closest(point(v)).first;
     for (int f = 0; f < source.num_faces(); ++f) {
       for (int c = 0; c < 3; ++c) star_[source.F(f, c)].push_back(f);
       bad_[f] = judge(f);
     }
-    // Each image's room: the larger of the diagonal's share and the share of its shortest edge.
-    const double diagonal_room = options.max_shift * surface_.diagonal();
-    for (int v = 0; v < source.num_vertices(); ++v) {
-      const double shortest = shortest_edge(v);
-      room_[v] = std::max(diagonal_room, std::isfinite(shortest) ? options.max_edge_share * shortest : 0.0);
-    }
+    for (int v = 0; v < source.num_vertices(); ++v) shortest_[v] = shortest_edge(v);
+    input_face_ = face_;
+    input_bad_ = bad_;
+    set_room(options.max_shift);
+  }
+
+  // Back to the input images, with each image's room the larger of max_shift × the diagonal and
+  // the edge share of its shortest input edge.
+  void restart(double max_shift) {
+    image_ = input_;
+    face_ = input_face_;
+    bad_ = input_bad_;
+    set_room(max_shift);
   }
 
   int bad_count() const { return static_cast<int>(std::count(bad_.begin(), bad_.end(), true)); }
@@ -95,6 +103,12 @@ class Untangler {
   };
 
   Eigen::Vector3d point(int v) const { return image_.row(v).transpose(); }
+
+  void set_room(double max_shift) {
+    const double diagonal_room = max_shift * surface_.diagonal();
+    for (int v = 0; v < source_.num_vertices(); ++v)
+      room_[v] = std::max(diagonal_room, std::isfinite(shortest_[v]) ? edge_share_ * shortest_[v] : 0.0);
+  }
 
   // The vertices within kOptimiseRings edges of a bad triangle, in index order.
   std::vector<int> near_bad() const {
@@ -276,6 +290,10 @@ class Untangler {
   std::vector<std::vector<int>> star_;  // source faces round each vertex
   std::vector<bool> bad_;               // per source face: flipped or degenerate image
   std::vector<double> room_;            // per image: how far it may move from input_
+  std::vector<double> shortest_;        // per image: its shortest non-zero edge in the input
+  std::vector<int> input_face_;         // face_ and bad_ for the input images
+  std::vector<bool> input_bad_;
+  double edge_share_;
 };
 
 }  // namespace
@@ -285,16 +303,31 @@ ImageUntangleResult untangle_image(const TriMesh& source, const Eigen::MatrixX3d
   if (image.rows() != source.num_vertices() || !image.allFinite())
     throw std::invalid_argument("untangle_image: image needs one finite row per source vertex (" +
                                 std::to_string(source.num_vertices()) + "), got " + std::to_string(image.rows()) + " rows");
-  if (options.sweeps < 0 || !(options.max_shift >= 0) || !(options.max_edge_share >= 0))
-    throw std::invalid_argument("untangle_image: sweeps, max_shift and max_edge_share must be >= 0");
+  if (options.sweeps < 0 || !(options.max_shift >= 0) || !(options.max_edge_share >= 0) ||
+      std::any_of(options.wider_shifts.begin(), options.wider_shifts.end(), [](double x) { return !(x >= 0); }))
+    throw std::invalid_argument("untangle_image: sweeps, max_shift, max_edge_share and wider_shifts must be >= 0");
   Untangler untangler(source, image, target, options);
   ImageUntangleResult result;
   result.bad_before = untangler.bad_count();
   const double diagonal = bounding_box(target.V).diagonal();
-  for (int s = 0; s < options.sweeps && untangler.bad_count() > 0; ++s)
-    if (!untangler.sweep() && !untangler.optimise()) break;
+  auto run = [&]() {
+    for (int s = 0; s < options.sweeps && untangler.bad_count() > 0; ++s)
+      if (!untangler.sweep() && !untangler.optimise()) break;
+  };
+  run();
   result.image = untangler.image();
   result.bad_after = untangler.bad_count();
+  result.shift_allowed = options.max_shift;
+  for (const double shift : options.wider_shifts) {
+    if (result.bad_after == 0) break;
+    untangler.restart(shift);
+    run();
+    if (untangler.bad_count() < result.bad_after) {
+      result.image = untangler.image();
+      result.bad_after = untangler.bad_count();
+      result.shift_allowed = shift;
+    }
+  }
   for (int v = 0; v < source.num_vertices(); ++v) {
     const double shift = (result.image.row(v) - image.row(v)).norm();
     if (shift > 0) {

@@ -37,6 +37,8 @@
 
 #include <Eigen/Core>
 
+#include <vector>
+
 namespace polycube {
 
 struct ImageUntangleOptions {
@@ -48,6 +50,12 @@ struct ImageUntangleOptions {
   // span much of P, a move of a few per cent of the diagonal is small against them).
   double max_shift = 0.01;
   double max_edge_share = 0.25;
+  // When bad triangles remain after the run at max_shift: runs again from the input images with
+  // each of these shifts in turn (fractions of the diagonal, as max_shift), until one leaves none.
+  // The result is the run that leaves the fewest (the earliest of equals): the moves are greedy and
+  // depend on the room, so a wider shift is not always better. The set-up (closest faces, the
+  // audit's verdicts on the input) is made once for all runs.
+  std::vector<double> wider_shifts;
 };
 
 // The corrected images and what it took.
@@ -56,18 +64,20 @@ struct ImageUntangleOptions {
 //   bad_after    the same after the step (<= bad_before)
 //   moved        vertices whose image moved
 //   max_shift    largest distance of a moved image from its input position / target diagonal
+//   shift_allowed  the max_shift of the run kept (options.max_shift or one of wider_shifts)
 struct ImageUntangleResult {
   Eigen::MatrixX3d image;
   int bad_before = 0;
   int bad_after = 0;
   int moved = 0;
   double max_shift = 0;
+  double shift_allowed = 0;
 };
 
 // Untangles one direction of a map: source's triangles at the positions `image` (points of
 // target) against the closed, outward-oriented surface target.
 // Throws std::invalid_argument when image does not have one finite row per source vertex, for a
-// target without area, or for negative options.
+// target without area, or for negative options (wider_shifts included).
 ImageUntangleResult untangle_image(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target,
                                    const ImageUntangleOptions& options = {});
 

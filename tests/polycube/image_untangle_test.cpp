@@ -97,6 +97,43 @@ TEST(ImageUntangle, MovesNothingWithoutRoomOrFolds) {
   EXPECT_EQ(stuck.moved, 0);
 }
 
+// The wider runs (ImageUntangleOptions::wider_shifts) start again from the input images: the
+// fold of a vertex dragged past two neighbours is stuck with a 2 % room, half undone with 5 %,
+// undone with 10 %, and that run is exactly the run made with 10 % from the start (the set-up
+// shared by the runs is reset with the images).
+TEST(ImageUntangle, AWiderShiftRunsAgainFromTheInput) {
+  const int n = 10;
+  const TriMesh grid = flat_grid(n);
+  Eigen::MatrixX3d image = grid.V;
+  image.row(vertex(n, 5, 5)) << 7.8, 5.2, 0;
+  ImageUntangleOptions narrow;
+  narrow.max_shift = 0.02;
+  narrow.max_edge_share = 0;
+  const ImageUntangleResult stuck = untangle_image(grid, image, grid, narrow);
+  ASSERT_GT(stuck.bad_after, 0);
+  ASSERT_EQ(stuck.bad_after, stuck.bad_before);
+  ImageUntangleOptions middle = narrow;
+  middle.max_shift = 0.05;
+  const int middle_left = untangle_image(grid, image, grid, middle).bad_after;
+  ASSERT_GT(middle_left, 0);
+  ASSERT_LT(middle_left, stuck.bad_before);
+
+  ImageUntangleOptions wider = narrow;
+  wider.wider_shifts = {0.05, 0.1, 0.2};
+  const ImageUntangleResult result = untangle_image(grid, image, grid, wider);
+  EXPECT_EQ(result.bad_before, stuck.bad_before);
+  EXPECT_EQ(result.bad_after, 0);
+  EXPECT_EQ(result.shift_allowed, 0.1);  // the first that leaves none; 0.2 is not run
+  EXPECT_LE(result.max_shift, 0.1 + 1e-12);
+  ImageUntangleOptions direct = narrow;
+  direct.max_shift = 0.1;
+  const ImageUntangleResult once = untangle_image(grid, image, grid, direct);
+  EXPECT_EQ(result.image, once.image);
+  EXPECT_EQ(result.moved, once.moved);
+  // Without wider shifts the first run is the result.
+  EXPECT_EQ(stuck.shift_allowed, 0.02);
+}
+
 TEST(ImageUntangle, RejectsBadArguments) {
   const TriMesh grid = flat_grid(3);
   EXPECT_THROW(untangle_image(grid, Eigen::MatrixX3d::Zero(3, 3), grid), std::invalid_argument);
@@ -108,6 +145,9 @@ TEST(ImageUntangle, RejectsBadArguments) {
   EXPECT_THROW(untangle_image(grid, grid.V, grid, options), std::invalid_argument);
   options.max_shift = 0.01;
   options.max_edge_share = -1;
+  EXPECT_THROW(untangle_image(grid, grid.V, grid, options), std::invalid_argument);
+  options.max_edge_share = 0.25;
+  options.wider_shifts = {0.05, -0.1};
   EXPECT_THROW(untangle_image(grid, grid.V, grid, options), std::invalid_argument);
 }
 
