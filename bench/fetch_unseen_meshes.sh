@@ -21,3 +21,23 @@ for m in "${meshes[@]}"; do
   [ -f "$m.off" ] || tar -xzf data.tar.gz -O "data/meshes/$m.off" > "$m.off"
 done
 echo "bench/unseen-data: ${#meshes[@]} meshes"
+# The rest of the archive's closed meshes (first run 2026-12-05, twenty-first session): copies of
+# a shape in other files, formats and vertex orders too (shuffled, .ply, .stl).
+more=(beam.off blob-closed.off blobby-shuffled.off bunny00.off cheese-box.off colored_tetra.ply corner_poly.off
+      cross_quad.off cube-shuffled.off cube4-shuffled.off cube_poly.off cube_quad.off ellipsoid.off fandisk-box.off
+      fandisk_large.off geosphere.off horizons-domain.off itemb.off mpi_triang.off pinion_small.off prim.off
+      quint_tris.off reference_tetrahedron.off refined_elephant.off small_cube.off sphere.ply sphere.stl
+      sphere966.off tet-shuffled.off translated-cube.off)
+mkdir -p more
+for m in "${more[@]}"; do
+  [ -f "more/$m" ] || tar -xzf data.tar.gz -O "data/meshes/$m" > "more/$m"
+done
+echo "bench/unseen-data/more: ${#more[@]} meshes"
+# Open or split meshes that `--fill-holes --largest-component` makes mappable.
+open=(ChineseDragon-10kv blade blobby_3cc bones cylinder double-torus-3-holes elephant-with-holes head holes knot2
+      lion-head lion mannequin-devil mech-holes-shark mushroom nefertiti pig three_peaks)
+mkdir -p open
+for m in "${open[@]}"; do
+  [ -f "open/$m.off" ] || tar -xzf data.tar.gz -O "data/meshes/$m.off" > "open/$m.off"
+done
+echo "bench/unseen-data/open: ${#open[@]} meshes (map them with --fill-holes --largest-component)"

@@ -413,9 +413,10 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       progress.warning(key + ": " + e.what());
     }
   };
-  // Still short, on the split model: the whole search again on the model as read. The split is what CAD models need, but on coarse organic
-  // ones whose quads fall short (thin parts, folds) it was no better and sometimes worse (femur's
-  // quads on the split model: 31 flipped and 2.42 %; on the model as read 1 and 1.37 %).
+  // Still short, on the split model: the whole search again on the model as read. The split is
+  // what CAD models need, but on coarse organic ones whose quads fall short (thin parts, folds) it
+  // was no better and sometimes worse (femur's quads on the split model: 31 flipped and 2.42 %; on
+  // the model as read 1 and 1.37 %).
   if (kept->worth_retrying() && options.map_dir.empty() && split_model.split)
     search_again(options.polycube, "model_as_read", ", model as read", "on the model as read (long edges not split)", as_read);
   // The later searches run on the model as read, then on the split model: so every search made

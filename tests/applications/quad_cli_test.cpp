@@ -264,6 +264,31 @@ TEST(QuadCli, QuadsStillShortTryFinerContours) {
 // map is built: the map's disk maps on 4 triangles shear the quads (about 29 deg mean angle
 // deviation from 90 at 1000 quads, one orientation, no refinement), on the split model they do
 // not (about 9). The quads lie on the model as read and are measured against it.
+// Every try after the first is capped at 1.5 × --refine-bound-growth × --target-faces quads:
+// eight at 50 quads (cap 225) falls short of the bound, and the orientation search's next
+// candidates, whose layouts need 611 cells, are given up at once with why; the first try, never
+// capped, makes its quads (more than asked, with a warning) and is kept.
+TEST(QuadCli, EveryTryAfterTheFirstIsCapped) {
+  const std::string dir = test::temp_dir("quad-capped");
+  const std::string out = dir + "/quads.obj", report_path = dir + "/report.json";
+  const test::CliRun run = polycube_cli("quad " + quoted(test::data_path("eight.off")) +
+                                        " --target-faces 50 --finer-contours 1 --thin-parts 0 -o " + quoted(out) +
+                                        " --report " + quoted(report_path));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
+  ASSERT_TRUE(report["alignment"].contains("given_up")) << "no try after the first was given up: pick another case";
+  const std::string chosen = report["alignment"]["chosen"].get<std::string>();
+  for (const nlohmann::json& g : report["alignment"]["given_up"]) {
+    EXPECT_NE(g["name"].get<std::string>(), chosen);
+    EXPECT_EQ(g["name"].get<std::string>().find("finer contours"), std::string::npos) << "a first-search candidate";
+    EXPECT_NE(g["why"].get<std::string>().find("more than the limit 225"), std::string::npos) << g["why"];
+  }
+  const QuadMesh quads = read_quads(out);
+  EXPECT_GT(quads.num_quads(), 225);
+  EXPECT_EQ(report["quality"]["quads"].get<int>(), quads.num_quads());
+  EXPECT_NE(run.err.find("warning: made "), std::string::npos) << run.err;
+}
+
 TEST(QuadCli, CoarseModelIsSplitBeforeTheMap) {
   const std::string dir = test::temp_dir("quad-split");
   const std::string base = "quad " + quoted(test::data_path("tetrahedron.off")) +
