@@ -233,9 +233,10 @@ std::string refinement_line(const MapRefinementResult& r) {
 // direction is still flipped or degenerate, single vertex images move on the target surface until
 // the audit passes there; then that direction's audit again. When moves within max_shift leave a
 // bad triangle, the untangling runs again from the map's images with 2, 5 and 10 times that
-// shift, up to shift_cap (ImageUntangleOptions::wider_shifts), while bad triangles remain; the
-// run leaving the fewest is kept. The greedy moves differ with the shift, so a larger one is not
-// always better (a coarse CAD model, mpi_triang: 3 left at 0.01, 2 at 0.02, 0 at 0.05, 1 at 0.1).
+// shift, up to shift_cap (ImageUntangleOptions::wider_shifts), while each run leaves fewer bad
+// triangles than the best before it; the best is kept. The greedy moves differ with the shift, so
+// a larger one is not always better (a coarse CAD model, mpi_triang: 3 left at 0.01, 2 at 0.02, 0
+// at 0.05, 1 at 0.1).
 void untangle_images(const TriMesh& model, Finished& out, double max_shift, double shift_cap, const Progress& progress) {
   if ((out.bad_p() == 0 && out.bad_m() == 0) || max_shift <= 0) return;
   const double start = progress.elapsed_seconds();

@@ -322,11 +322,10 @@ ImageUntangleResult untangle_image(const TriMesh& source, const Eigen::MatrixX3d
     if (result.bad_after == 0) break;
     untangler.restart(shift);
     run();
-    if (untangler.bad_count() < result.bad_after) {
-      result.image = untangler.image();
-      result.bad_after = untangler.bad_count();
-      result.shift_allowed = shift;
-    }
+    if (!(untangler.bad_count() < result.bad_after)) break;  // more room brought nothing: stop
+    result.image = untangler.image();
+    result.bad_after = untangler.bad_count();
+    result.shift_allowed = shift;
   }
   for (int v = 0; v < source.num_vertices(); ++v) {
     const double shift = (result.image.row(v) - image.row(v)).norm();

@@ -100,7 +100,7 @@ TEST(ImageUntangle, MovesNothingWithoutRoomOrFolds) {
 // The wider runs (ImageUntangleOptions::wider_shifts) start again from the input images: the
 // fold of a vertex dragged past two neighbours is stuck with a 2 % room, half undone with 5 %,
 // undone with 10 %, and that run is exactly the run made with 10 % from the start (the set-up
-// shared by the runs is reset with the images).
+// shared by the runs is reset with the images). They go on only while each does better.
 TEST(ImageUntangle, AWiderShiftRunsAgainFromTheInput) {
   const int n = 10;
   const TriMesh grid = flat_grid(n);
@@ -132,6 +132,14 @@ TEST(ImageUntangle, AWiderShiftRunsAgainFromTheInput) {
   EXPECT_EQ(result.moved, once.moved);
   // Without wider shifts the first run is the result.
   EXPECT_EQ(stuck.shift_allowed, 0.02);
+  // A wider run that leaves as many as the best before it ends the search: 3 % leaves the 2 of
+  // 2 %, so 10 % is not run.
+  ImageUntangleOptions fruitless = narrow;
+  fruitless.wider_shifts = {0.03, 0.1};
+  const ImageUntangleResult stopped = untangle_image(grid, image, grid, fruitless);
+  EXPECT_EQ(stopped.bad_after, stuck.bad_after);
+  EXPECT_EQ(stopped.shift_allowed, 0.02);
+  EXPECT_EQ(stopped.image, stuck.image);
 }
 
 TEST(ImageUntangle, RejectsBadArguments) {
