@@ -30,18 +30,30 @@ TriMesh flat_grid(int n) {
 
 int vertex(int n, int i, int j) { return j * (n + 1) + i; }
 
+// The grid's own positions with vertex (i, j) of the n × n grid moved to (x, y, 0).
+Eigen::MatrixX3d moved_vertex(const TriMesh& grid, int n, int i, int j, double x, double y) {
+  Eigen::MatrixX3d image = grid.V;
+  image.row(vertex(n, i, j)) << x, y, 0;
+  return image;
+}
+
+// Options whose room is max_shift of the diagonal alone (no share of the shortest edge).
+ImageUntangleOptions room_of(double max_shift) {
+  ImageUntangleOptions options;
+  options.max_shift = max_shift;
+  options.max_edge_share = 0;
+  return options;
+}
+
 TEST(ImageUntangle, UnfoldsAVertexDraggedAcrossItsNeighbours) {
   const int n = 10;
   const TriMesh grid = flat_grid(n);
-  Eigen::MatrixX3d image = grid.V;
   // The vertex (5, 5) dragged past its right neighbour: its fan folds over.
-  image.row(vertex(n, 5, 5)) << 6.3, 5.2, 0;
+  const Eigen::MatrixX3d image = moved_vertex(grid, n, 5, 5, 6.3, 5.2);
   const MapDirectionAudit folded = audit_map_direction(grid, image, grid);
   ASSERT_GT(folded.flipped, 0);
 
-  ImageUntangleOptions options;
-  options.max_shift = 0.2;  // the drag was 1.3 / 14.1 of the diagonal
-  options.max_edge_share = 0;
+  const ImageUntangleOptions options = room_of(0.2);  // the drag was 1.3 / 14.1 of the diagonal
   const ImageUntangleResult result = untangle_image(grid, image, grid, options);
   EXPECT_EQ(result.bad_before, folded.flipped + folded.degenerate);
   EXPECT_EQ(result.bad_after, 0);
@@ -67,8 +79,7 @@ TEST(ImageUntangle, UnfoldsAReversedSliverByASmallMove) {
   const TriMesh grid = flat_grid(n);
   // A fan round (4, 4): squeeze the vertex (5, 4) towards the diagonal (4, 4)–(5, 5) so that the
   // triangle (4, 4), (5, 4), (5, 5) becomes a sliver, then just across.
-  Eigen::MatrixX3d image = grid.V;
-  image.row(vertex(n, 5, 4)) << 4.5 - 0.01, 4.5 + 0.01, 0;
+  const Eigen::MatrixX3d image = moved_vertex(grid, n, 5, 4, 4.5 - 0.01, 4.5 + 0.01);
   ASSERT_EQ(audit_map_direction(grid, image, grid).flipped, 1);
   const ImageUntangleResult result = untangle_image(grid, image, grid);
   EXPECT_EQ(result.bad_before, 1);
@@ -86,12 +97,8 @@ TEST(ImageUntangle, MovesNothingWithoutRoomOrFolds) {
   EXPECT_EQ(clean.moved, 0);
   EXPECT_EQ(clean.image, grid.V);
   // A fold but no room to move: left as it is, and counted.
-  Eigen::MatrixX3d image = grid.V;
-  image.row(vertex(n, 3, 3)) << 4.3, 3.2, 0;
-  ImageUntangleOptions options;
-  options.max_shift = 0;
-  options.max_edge_share = 0;
-  const ImageUntangleResult stuck = untangle_image(grid, image, grid, options);
+  const Eigen::MatrixX3d image = moved_vertex(grid, n, 3, 3, 4.3, 3.2);
+  const ImageUntangleResult stuck = untangle_image(grid, image, grid, room_of(0));
   EXPECT_GT(stuck.bad_before, 0);
   EXPECT_EQ(stuck.bad_after, stuck.bad_before);
   EXPECT_EQ(stuck.moved, 0);
@@ -104,17 +111,12 @@ TEST(ImageUntangle, MovesNothingWithoutRoomOrFolds) {
 TEST(ImageUntangle, AWiderShiftRunsAgainFromTheInput) {
   const int n = 10;
   const TriMesh grid = flat_grid(n);
-  Eigen::MatrixX3d image = grid.V;
-  image.row(vertex(n, 5, 5)) << 7.8, 5.2, 0;
-  ImageUntangleOptions narrow;
-  narrow.max_shift = 0.02;
-  narrow.max_edge_share = 0;
+  const Eigen::MatrixX3d image = moved_vertex(grid, n, 5, 5, 7.8, 5.2);
+  const ImageUntangleOptions narrow = room_of(0.02);
   const ImageUntangleResult stuck = untangle_image(grid, image, grid, narrow);
   ASSERT_GT(stuck.bad_after, 0);
   ASSERT_EQ(stuck.bad_after, stuck.bad_before);
-  ImageUntangleOptions middle = narrow;
-  middle.max_shift = 0.05;
-  const int middle_left = untangle_image(grid, image, grid, middle).bad_after;
+  const int middle_left = untangle_image(grid, image, grid, room_of(0.05)).bad_after;
   ASSERT_GT(middle_left, 0);
   ASSERT_LT(middle_left, stuck.bad_before);
 
@@ -125,9 +127,7 @@ TEST(ImageUntangle, AWiderShiftRunsAgainFromTheInput) {
   EXPECT_EQ(result.bad_after, 0);
   EXPECT_EQ(result.shift_allowed, 0.1);  // the first that leaves none; 0.2 is not run
   EXPECT_LE(result.max_shift, 0.1 + 1e-12);
-  ImageUntangleOptions direct = narrow;
-  direct.max_shift = 0.1;
-  const ImageUntangleResult once = untangle_image(grid, image, grid, direct);
+  const ImageUntangleResult once = untangle_image(grid, image, grid, room_of(0.1));
   EXPECT_EQ(result.image, once.image);
   EXPECT_EQ(result.moved, once.moved);
   // Without wider shifts the first run is the result.
