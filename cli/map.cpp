@@ -50,7 +50,7 @@ struct MapOptions {
   // The last untangling's largest move of an image, × the target's diagonal; 0: none.
   double untangle_shift = ImageUntangleOptions().max_shift;
   // Where moves within untangle_shift leave a bad triangle: the untangling again from the map's
-  // images with 2, 5 and 10 times that shift, at most this much.
+  // images with 2, 5 and 10 times that shift, at most this much, while each run leaves fewer.
   double untangle_shift_max = 0.1;
   // When no finished map of the orientation search meets the contract, the search and its maps
   // run once more with d_a divided by this (finer contours); 1: never.
@@ -765,7 +765,7 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
       ->check(CLI::Range(0.0, 0.1));
   command->add_option("--untangle-shift-max", options->untangle_shift_max,
                       "When moves within --untangle-shift leave a flipped triangle, untangle again with 2, 5 and 10 times that shift, "
-                      "at most this fraction of the diagonal (keeping the run that leaves the fewest)")
+                      "at most this fraction of the diagonal, while each run leaves fewer (the best is kept)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.5));
   command->add_option("--finer-contours", options->finer_contours,

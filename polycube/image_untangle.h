@@ -54,9 +54,9 @@ struct ImageUntangleOptions {
   // each of these shifts in turn (fractions of the diagonal, as max_shift, ascending) while each
   // run leaves fewer than the best before it and some are left; the result is the best run. (The
   // moves are greedy and depend on the room, so a wider shift is not always better; on a broadly
-  // folded map more room hardly helps — cheese, 6 to 81 left per direction: one fewer in 2 of its
-  // 11 finished maps — and a run that brings nothing ends the search.) The set-up (closest faces, the audit's verdicts on the
-  // input) is made once for all runs.
+  // folded map more room hardly helps — cheese, 6 to 81 left per direction: one fewer in 2 of
+  // its 11 finished maps — and a run that brings nothing ends the search.) The set-up (closest
+  // faces, the audit's verdicts on the input) is made once for all runs.
   std::vector<double> wider_shifts;
 };
 
