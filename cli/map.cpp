@@ -157,6 +157,24 @@ struct Finished {
   std::tuple<int, int, double, double> rank() const {
     return {bad_p() + bad_m(), meets_contract() ? 0 : 1, area_miss(), audit.distortion.eps_angle};
   }
+  // What of the contract the map misses, "; "-separated (empty when it meets it).
+  std::string shortfall() const {
+    std::ostringstream miss;
+    const char* separator = "";
+    if (bad_p() + bad_m() > 0) {
+      miss << bad_p() << " / " << bad_m() << " flipped or degenerate image triangles (P to M / M to P)";
+      separator = "; ";
+    }
+    if (area_miss() > 0) {
+      miss << separator << "P's image covers " << std::fixed << std::setprecision(4) << audit.polycube_to_model.area_ratio
+           << " of the model's area";
+      separator = "; ";
+    }
+    const double off = std::max(audit.polycube_to_model.max_distance, audit.model_to_polycube.max_distance);
+    if (off > MapAuditOptions().surface_tolerance)
+      miss << separator << "images up to " << std::setprecision(4) << off << " of the diagonal off the surface";
+    return miss.str();
+  }
 };
 
 // One orientation's stages (those the orientation search built come with it; candidate -1 with
@@ -689,20 +707,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                               std::to_string(audit.distortion.eps_angle));
     // The best map found is written either way; what it misses is said, and in the report.
     report["map"]["meets_contract"] = finished.meets_contract();
-    if (!finished.meets_contract()) {
-      std::ostringstream miss;
-      miss << "the map falls short of its contract:";
-      if (finished.bad_p() + finished.bad_m() > 0)
-        miss << " " << finished.bad_p() << " / " << finished.bad_m() << " flipped or degenerate image triangles (P to M / M to P);";
-      const double area = audit.polycube_to_model.area_ratio;
-      if (std::abs(area - 1) > MapAuditOptions().area_tolerance)
-        miss << " P's image covers " << std::fixed << std::setprecision(4) << area << " of the model's area;";
-      const double off = std::max(audit.polycube_to_model.max_distance, audit.model_to_polycube.max_distance);
-      if (off > MapAuditOptions().surface_tolerance) miss << " images up to " << std::setprecision(4) << off << " of the diagonal off the surface;";
-      std::string line = miss.str();
-      line.pop_back();
-      progress.warning(line);
-    }
+    if (!finished.meets_contract()) progress.warning("the map falls short of its contract: " + finished.shortfall());
   }
 
   const std::string pieces_path = (dir / "pieces.ply").string();
