@@ -1,5 +1,6 @@
 #include "applications/quad/quad_remesh.h"
 
+#include "applications/quad/quad_guard.h"
 #include "applications/quad/quad_templates.h"
 
 #include <algorithm>
@@ -30,6 +31,12 @@ constexpr double kExtendedRoundGrowth = 1.2;
 // Once a round's place cut a line by a bad quad, places within this many times the quad's size
 // on P (centre to farthest corner) of it are not refined again.
 constexpr double kBlockRadius = 3;
+// The mending of inverted corners at the end: tries, the distance slack (the quads may miss the
+// model by this factor of before), and the radius, in mean quad sizes, round the farthest misses
+// within which moved vertices are held for the next try.
+constexpr int kInvertedTries = 4;
+constexpr double kInvertedSlack = 1.01;
+constexpr double kInvertedHoldRadius = 3;
 
 // A pass's quads and what made them, into `to` (whose stage times and refinement figures stay).
 void take_pass(QuadRemeshResult& to, QuadRemeshResult pass) {
@@ -496,6 +503,74 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         result.untangling.moves += last.moves;
         result.untangling.patches += last.patches;
         result.untangling.flipped_after = last.flipped_after;
+      }
+      result.seconds_untangle += since(begin);
+    }
+  }
+  // Corners turned against the quad (non-convex quads, a negative Jacobian there): the vertices
+  // of those quads moved, and patches round them laid out again, while that lowers (bad quads,
+  // inverted corners); first with the fitted corners held, then, if some stay, with every vertex
+  // free. Kept when it flips nothing more and the quads miss the model no farther (1 % slack for
+  // the sampling); when they do, the moved vertices near the farthest misses are held and it is
+  // tried again (at most kInvertedTries times).
+  if (options.untangle.passes > 0 && options.fix_inverted_corners) {
+    QuadQualityOptions topology_only = options.quality;
+    topology_only.hausdorff = false;
+    const QuadQuality before = measure_quads(result.mesh, model, result.grid.corners, topology_only);
+    if (before.inverted_corners > 0) {
+      const auto begin = std::chrono::steady_clock::now();
+      const double diagonal = bounding_box(model.surface().V).diagonal();
+      const HausdorffOptions sampling = options.quality.sampling;
+      const double miss_before = hausdorff_distance(triangulate_quads(result.mesh), model.sampled(), sampling).hausdorff;
+      QuadUntangleOptions corners = options.untangle;
+      corners.inverted = true;
+      const int nv = result.mesh.num_vertices();
+      std::vector<char> held(nv, 0);  // vertices held for the distance
+      const double size = mean_quad_size(result.mesh);
+      bool kept = false;
+      for (int attempt = 0; attempt < kInvertedTries && !kept; ++attempt) {
+        std::vector<char> pinned = held;
+        for (int v = 0; v < nv && v < static_cast<int>(result.fitting.pinned.size()); ++v)
+          pinned[v] = pinned[v] || result.fitting.pinned[v];
+        QuadUntangleResult fixed = untangle_quads(result.mesh, model, corners, pinned);
+        QuadQuality after = measure_quads(fixed.mesh, model, result.grid.corners, topology_only);
+        if (after.inverted_corners > 0 && pinned != held) {
+          // Some are at fitted corners: those free too.
+          const int moves = fixed.moves, patches = fixed.patches;
+          fixed = untangle_quads(fixed.mesh, model, corners, held);
+          fixed.moves += moves;
+          fixed.patches += patches;
+          after = measure_quads(fixed.mesh, model, result.grid.corners, topology_only);
+        }
+        if (after.inverted_corners >= before.inverted_corners ||
+            after.flipped_quads + after.degenerate_quads > before.flipped_quads + before.degenerate_quads)
+          break;
+        const HausdorffDistance miss = hausdorff_distance(triangulate_quads(fixed.mesh), model.sampled(), sampling);
+        kept = miss.hausdorff <= kInvertedSlack * miss_before;
+        report("untangle", std::to_string(before.inverted_corners) + " inverted corners -> " +
+                               std::to_string(after.inverted_corners) + " (" + std::to_string(fixed.moves) + " moves, " +
+                               std::to_string(fixed.patches) + " patches; misses the model by " +
+                               format("%.3f -> %.3f %% of the diagonal): ", 100 * miss_before / diagonal,
+                                      100 * miss.hausdorff / diagonal) +
+                               (kept ? "kept" : "not kept"));
+        if (kept) {
+          result.mesh = std::move(fixed.mesh);
+          result.untangling.moves += fixed.moves;
+          result.untangling.patches += fixed.patches;
+          break;
+        }
+        // Hold the moved vertices near where the quads now miss the model most.
+        int newly = 0;
+        for (int v = 0; v < nv; ++v) {
+          if (held[v] || fixed.mesh.V.row(v) == result.mesh.V.row(v)) continue;
+          const Eigen::Vector3d p = result.mesh.V.row(v).transpose();
+          if ((p - miss.a_farthest).norm() <= kInvertedHoldRadius * size ||
+              (p - miss.b_farthest).norm() <= kInvertedHoldRadius * size) {
+            held[v] = 1;
+            ++newly;
+          }
+        }
+        if (newly == 0) break;
       }
       result.seconds_untangle += since(begin);
     }

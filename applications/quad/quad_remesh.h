@@ -58,6 +58,9 @@ struct QuadRemeshOptions {
   // After the fit, the vertices of flipped quads moved apart where that unflips them (passes 0:
   // not).
   QuadUntangleOptions untangle;
+  // At the end, quads with a corner turned against them (non-convex) untangled too (with
+  // untangle's passes; QuadUntangleOptions::inverted).
+  bool fix_inverted_corners = true;
   QuadQualityOptions quality;
   bool measure = true;  // false: skip measure_quads
 };

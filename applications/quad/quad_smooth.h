@@ -166,6 +166,10 @@ struct QuadUntangleOptions {
   int patch_rings = 6;  // 0: no patches
   // Collapsed quads count as bad (false: flipped ones only).
   bool collapsed = true;
+  // Quads with an inverted corner (non-convex or folded at a corner) are worked on too: their
+  // vertices seed the moves and they seed patches. The rule that takes a move stays the same
+  // (fewer bad quads, else as many and fewer inverted corners), so no quad turns bad for it.
+  bool inverted = false;
 };
 
 //   mesh           the quads (same connectivity)

@@ -289,6 +289,8 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     int flipped = 0, collapsed = 0, inverted = 0;
     bool bad() const { return flipped + collapsed > 0; }
   };
+  // What the moves and patches work on.
+  const auto worked_on = [&](const Badness& b) { return b.bad() || (options.inverted && b.inverted > 0); };
   const auto badness = [&](int q) {
     SurfaceHit centre;
     const int bits = guard.state(q, centre, size);
@@ -346,7 +348,7 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
                      mesh.V.row(mesh.Q(q, (c + 3) % 4)).transpose()) /
                     (4.0 * around[v].size());
       targets[2] += parallelogram / static_cast<double>(around[v].size());
-      if (state[q].bad()) targets.push_back(parallelogram);
+      if (worked_on(state[q])) targets.push_back(parallelogram);
       if (state[q].collapsed) {
         // A quad squashed onto a line (its neighbours often with it): off the line both ways, in
         // the surface's tangent plane, by half its longest edge.
@@ -381,7 +383,7 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     std::vector<char> in(nv, 0);
     std::vector<int> front;
     for (int q = 0; q < nq; ++q)
-      if (state[q].bad())
+      if (worked_on(state[q]))
         for (int k = 0; k < 4; ++k)
           if (!in[mesh.Q(q, k)]) {
             in[mesh.Q(q, k)] = 1;
@@ -404,10 +406,10 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     }
     if (!moved) break;
   }
-  if (options.patch_rings > 0 && std::any_of(state.begin(), state.end(), [](const Badness& b) { return b.bad(); })) {
+  if (options.patch_rings > 0 && std::any_of(state.begin(), state.end(), worked_on)) {
     const PatchEmbedder embedder(mesh, surface, neighbours, pinned);
     for (int q = 0; q < nq; ++q) {
-      if (!state[q].bad()) continue;
+      if (!worked_on(state[q])) continue;
       // Patches ring by ring, and round ones (by distance: the quads a map folds are often
       // long and thin, and rings of them make a ragged patch).
       for (int attempt = 0; attempt < 2 * options.patch_rings; ++attempt) {
