@@ -155,6 +155,7 @@ nlohmann::json quality_json(const QuadQuality& q) {
           {"aspect_ratio", {{"mean", q.aspect_ratio_mean}, {"max", q.aspect_ratio_max}}},
           {"flipped_quads", q.flipped_quads},
           {"inverted_corners", q.inverted_corners},
+          {"sharp_corners", q.sharp_corners},
           {"degenerate_quads", q.degenerate_quads},
           {"max_vertex_distance", q.max_distance_to_surface},
           {"hausdorff", q.hausdorff_measured ? nlohmann::json(q.hausdorff) : nlohmann::json()},

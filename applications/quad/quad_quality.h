@@ -17,6 +17,9 @@ struct QuadQualityOptions {
   // A quad is degenerate when its area or an edge is below this times the reference's diagonal
   // (squared for the area).
   double degenerate_tolerance = 1e-10;
+  // A corner is sharp when its angle is this many degrees or more from 90° either way (below 30°
+  // or above 150° by default: a scaled Jacobian below 0.5 there).
+  double sharp_degrees = 60;
   // Threads for the closest points and the Hausdorff samples (0: one per hardware thread); the
   // figures do not depend on it.
   int threads = 0;
@@ -34,6 +37,7 @@ struct QuadQualityOptions {
 //                           quad_surface_normal (the criterion smooth_quads keeps)
 //   inverted_corners        quad corners whose two edges turn against it (non-convex or folded
 //                           quads)
+//   sharp_corners           quad corners more than sharp_degrees from 90° (nearly shut or flat)
 //   degenerate_quads        zero area or zero-length edge
 //   max_distance_to_surface largest vertex distance to the reference surface
 //   hausdorff               sampled two-sided distance between the triangulated quads and the
@@ -57,6 +61,7 @@ struct QuadQuality {
   double aspect_ratio_max = 0;
   int flipped_quads = 0;
   int inverted_corners = 0;
+  int sharp_corners = 0;
   int degenerate_quads = 0;
   double max_distance_to_surface = 0;
   bool hausdorff_measured = false;

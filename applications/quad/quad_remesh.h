@@ -24,6 +24,8 @@
 //                                                quads they split, relaxed round them, fitted
 //   quads   = untangle_quads(quads, M)          optional, when quads are bad: every vertex free,
 //                                                collapsed quads bad too, patches laid out again
+//   quads   = untangle_quads(quads, M)          optional (mend_corners): inverted and sharp
+//                                                corners too; kept when the quads miss M no farther
 //   quality = measure_quads(quads, M, corners)
 #pragma once
 
@@ -58,9 +60,11 @@ struct QuadRemeshOptions {
   // After the fit, the vertices of flipped quads moved apart where that unflips them (passes 0:
   // not).
   QuadUntangleOptions untangle;
-  // At the end, quads with a corner turned against them (non-convex) untangled too (with
-  // untangle's passes; QuadUntangleOptions::inverted).
-  bool fix_inverted_corners = true;
+  // At the end, quads with inverted corners (non-convex) or sharp ones (quality.sharp_degrees
+  // from 90°) mended by the untangling's moves and patches (with untangle's passes;
+  // QuadUntangleOptions::inverted, sharp_degrees), held where the quads would miss the model
+  // farther.
+  bool mend_corners = true;
   QuadQualityOptions quality;
   bool measure = true;  // false: skip measure_quads
 };

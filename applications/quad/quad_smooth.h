@@ -170,6 +170,10 @@ struct QuadUntangleOptions {
   // vertices seed the moves and they seed patches. The rule that takes a move stays the same
   // (fewer bad quads, else as many and fewer inverted corners), so no quad turns bad for it.
   bool inverted = false;
+  // Corners further than this many degrees from 90° (nearly shut or folded flat; measure_quads'
+  // sharp corners) count third: a move or patch is also taken when it keeps the bad quads and
+  // the inverted corners and has fewer of these, and their quads are worked on. 0: not counted.
+  double sharp_degrees = 0;
 };
 
 //   mesh           the quads (same connectivity)

@@ -8,10 +8,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -286,11 +288,14 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
   const double degenerate_length = QuadQualityOptions{}.degenerate_tolerance * diagonal;
   const double degenerate_area = degenerate_length * diagonal;
   struct Badness {
-    int flipped = 0, collapsed = 0, inverted = 0;
+    int flipped = 0, collapsed = 0, inverted = 0, sharp = 0;
     bool bad() const { return flipped + collapsed > 0; }
   };
   // What the moves and patches work on.
-  const auto worked_on = [&](const Badness& b) { return b.bad() || (options.inverted && b.inverted > 0); };
+  const auto worked_on = [&](const Badness& b) {
+    return b.bad() || (options.inverted && b.inverted > 0) || b.sharp > 0;
+  };
+  const double cos_limit = options.sharp_degrees > 0 ? std::sin(options.sharp_degrees * M_PI / 180) : 2;
   const auto badness = [&](int q) {
     SurfaceHit centre;
     const int bits = guard.state(q, centre, size);
@@ -305,6 +310,13 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     const Eigen::Vector3d d2 = mesh.V.row(mesh.Q(q, 3)) - mesh.V.row(mesh.Q(q, 1));
     b.collapsed = b.collapsed || d1.cross(d2).norm() / 2 <= std::max(shortest * shortest, degenerate_area);
     if (!options.collapsed) b.collapsed = 0;
+    if (cos_limit <= 1)
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d a = mesh.V.row(mesh.Q(q, (k + 1) % 4)) - mesh.V.row(mesh.Q(q, k));
+        const Eigen::Vector3d c = mesh.V.row(mesh.Q(q, (k + 3) % 4)) - mesh.V.row(mesh.Q(q, k));
+        const double lengths = a.norm() * c.norm();
+        b.sharp += lengths > 0 && std::abs(a.dot(c)) > cos_limit * lengths;
+      }
     return b;
   };
   std::vector<Badness> state(nq);
@@ -316,10 +328,11 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
   };
   result.flipped_before = result.flipped_after = count_flipped();
   const auto sum = [](const std::vector<Badness>& of) {
-    std::pair<int, int> total{0, 0};
+    std::tuple<int, int, int> total{0, 0, 0};
     for (const Badness& b : of) {
-      total.first += b.flipped + b.collapsed;
-      total.second += b.inverted;
+      std::get<0>(total) += b.flipped + b.collapsed;
+      std::get<1>(total) += b.inverted;
+      std::get<2>(total) += b.sharp;
     }
     return total;
   };
@@ -330,8 +343,8 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     if ((!pinned.empty() && pinned[v]) || neighbours[v].empty()) return false;
     before.clear();
     for (int q : around[v]) before.push_back(state[q]);
-    const std::pair<int, int> was = sum(before);
-    if (was.first == 0 && was.second == 0) return false;
+    const std::tuple<int, int, int> was = sum(before);
+    if (was == std::tuple<int, int, int>{0, 0, 0}) return false;
     const Eigen::Vector3d p = mesh.V.row(v);
     const SurfaceHit here = surface.closest(p);
     // The mean of the edge neighbours, of the quads' centres, of the parallelogram corners

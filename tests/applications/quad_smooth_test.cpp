@@ -45,7 +45,7 @@ QuadRemeshResult remesh(const Mapped& m, int quads, int sweeps, bool mend_corner
   options.grid.target_quads = quads;
   options.smooth.sweeps = sweeps;
   options.refine.rounds = 0;  // the same grid either way: what the relaxation does is compared
-  options.fix_inverted_corners = mend_corners;  // off: nor the mending at the end
+  options.mend_corners = mend_corners;  // off: nor the mending at the end
   const SurfaceMap to_model = [&m](const SurfacePoint& p) { return surface_position(m.model, m.map.to_model(p)); };
   return remesh_quads(m.polycube.polycube.mesh, to_model, *m.projector, options);
 }
@@ -212,6 +212,34 @@ TEST(QuadUntangle, MendsInvertedCornersWhenAsked) {
 
   std::vector<char> pinned(25, 1);
   EXPECT_EQ(untangle_quads(grid, top, corners, pinned).mesh.V, grid.V) << "every vertex pinned";
+}
+
+// The same grid with vertex 6 pulled from (0.3, 0.3) towards the middle: quad 6-11-12-7 gets a
+// 157° corner (sharp at 60°), nothing is inverted or flipped. Counted as sharp, it is mended.
+TEST(QuadUntangle, MendsSharpCornersWhenAsked) {
+  const TriMesh box = thin_box(0.1);
+  const SurfaceProjector top(box);
+  QuadMesh grid = top_grid(4, 0.1, 0.2);
+  grid.V.row(6) << 0.38, 0.38, 0.1;
+  QuadQualityOptions no_distance;
+  no_distance.hausdorff = false;
+  no_distance.sharp_degrees = 60;
+  const QuadQuality before = measure_quads(grid, top, {}, no_distance);
+  ASSERT_EQ(before.flipped_quads, 0);
+  ASSERT_EQ(before.inverted_corners, 0);
+  ASSERT_EQ(before.sharp_corners, 1) << "the test needs a sharp corner";
+
+  QuadUntangleOptions corners;
+  corners.inverted = true;
+  EXPECT_EQ(untangle_quads(grid, top, corners).mesh.V, grid.V) << "sharp corners not counted: nothing to do";
+  corners.sharp_degrees = 60;
+  const QuadUntangleResult r = untangle_quads(grid, top, corners);
+  const QuadQuality after = measure_quads(r.mesh, top, {}, no_distance);
+  EXPECT_EQ(after.sharp_corners, 0);
+  EXPECT_EQ(after.inverted_corners, 0);
+  EXPECT_EQ(after.flipped_quads, 0);
+  EXPECT_LT(after.angle_deviation_max, before.angle_deviation_max);
+  for (int v = 0; v < 25; ++v) EXPECT_NEAR(r.mesh.V(v, 2), 0.1, 1e-12) << "on the top face";
 }
 
 // A 4 x 4 grid on the box's top face with its middle vertex on its neighbour (a map sent both to
