@@ -6,7 +6,7 @@ Usage: bench/quad_bench.py [--binary build/polycube] [--output bench/quad-table.
 
 Default meshes: every mesh of ../shared/data/paper and ../shared/data/dev when present
 (laurana-open with --fill-holes). Per mesh, from the --report JSON: quads, irregular vertices and
-P's cone points, the refinement's rounds, halved chord parts and template rounds, angle deviation from 90° (mean / p95 / max), flipped quads / inverted corners,
+P's cone points, the refinement's rounds, halved chord parts and template rounds, angle deviation from 90° (mean / p95 / max), flipped quads / inverted corners / sharp corners (beyond 60° from square),
 degenerate quads, the Hausdorff distance (% of the diagonal, both one-sided distances), the fit's
 pulled corners, the triangles the map was built on (the model's long edges split: rounds), seconds
 per stage, wall time and peak RSS (/usr/bin/time). Standard library only.
@@ -52,15 +52,15 @@ def main():
         stages = " / ".join("%.2f" % s.get(k, 0) for k in stage_names)
         g = r.get("grid", {})
         split = r.get("split", {})
-        rows.append("| %s | %d | %d / %d / %d | %d | %d | %.2f / %.1f / %.1f | %d / %d | %d | %.3f (%.3f / %.3f) | %d | %s | %s | %.2f | %.2f | %.0f |" % (
+        rows.append("| %s | %d | %d / %d / %d | %d | %d | %.2f / %.1f / %.1f | %d / %d / %s | %d | %.3f (%.3f / %.3f) | %d | %s | %s | %.2f | %.2f | %.0f |" % (
             name, q["quads"], g.get("refine_rounds", 0), g.get("refined_chord_parts", 0), g.get("template_rounds", 0), q["irregular_vertices"], q["irregular_at_corners"], ang["mean"], ang["p95"], ang["max"],
-            q["flipped_quads"], q["inverted_corners"], q["degenerate_quads"], q["hausdorff_percent_diagonal"],
+            q["flipped_quads"], q["inverted_corners"], q.get("sharp_corners", "–"), q["degenerate_quads"], q["hausdorff_percent_diagonal"],
             100 * sides["quads_to_model"] / diag, 100 * sides["model_to_quads"] / diag,
             r.get("fitting", {}).get("snapped", 0),
             "%d (%d)" % (split["triangles"], split["rounds"]) if split else "-", stages, s["total"], wall, rss))
         print(rows[-1], file=sys.stderr)
     header = [
-        "| mesh | quads | refinement rounds / parts halved / template rounds | irregular | of them at P's cones | angle dev. mean / p95 / max ° | flipped / inverted corners | degenerate | Hausdorff % diag (quads→model / model→quads) | corners pulled by the fit | triangles mapped (split rounds) | seconds " + " / ".join(stage_names) + " | total s | wall s | peak RSS MB |",
+        "| mesh | quads | refinement rounds / parts halved / template rounds | irregular | of them at P's cones | angle dev. mean / p95 / max ° | flipped / inverted corners / sharp corners | degenerate | Hausdorff % diag (quads→model / model→quads) | corners pulled by the fit | triangles mapped (split rounds) | seconds " + " / ".join(stage_names) + " | total s | wall s | peak RSS MB |",
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     with open(a.output, "w") as f:

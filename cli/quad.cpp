@@ -284,6 +284,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   remesh.carry.threads = 0;  // both maps only read; interpolation and closest points are thread-safe
   remesh.refine.threads = remesh.carry.threads;
   if (!options.fit) remesh.fit.passes = 0;
+  remesh.mend_corners = false;  // only the kept try's corners are mended (below)
   const auto report_stage = [&progress](const std::string& stage, const std::string& message) { progress.stage(stage, message); };
   std::vector<std::unique_ptr<QuadAttempt>> attempts;
   if (!options.map_dir.empty()) {
@@ -460,6 +461,12 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     std::ostringstream suffix;
     suffix << ", thin parts kept (" << thin.feature_distance << ")" << model_suffix(*on);
     search_again(thin, model_key("thin_parts", *on), suffix.str(), "keeping thin parts" + std::string(model_suffix(*on)), *on);
+  }
+  {
+    // The kept try's corners mended (the other tries are only compared).
+    QuadRemeshOptions mend = remesh;
+    mend.mend_corners = true;
+    mend_quad_corners(*kept->result, *kept->on->projector(), mend, report_stage);
   }
   if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;

@@ -54,7 +54,125 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0) {
   std::snprintf(text, sizeof text, pattern, a, b, c);
   return text;
 }
+
+// measure_quads on the result, its time and a line of progress.
+void measure_result(QuadRemeshResult& result, const SurfaceProjector& model, const QuadRemeshOptions& options,
+                    const std::function<void(const std::string&, const std::string&)>& report) {
+  report("quality", options.quality.hausdorff ? "angles, flips, Hausdorff distance" : "angles, flips");
+  const auto start = std::chrono::steady_clock::now();
+  result.quality = measure_quads(result.mesh, model, result.grid.corners, options.quality);
+  result.seconds_quality = since(start);
+  const QuadQuality& q = result.quality;
+  std::string message = std::to_string(q.quads) + " quads, " + std::to_string(q.irregular_vertices) + " irregular (" +
+                        std::to_string(q.irregular_at_corners) + " at polycube corners), angle deviation " +
+                        format("%.2f / %.2f / %.1f deg (mean / p95 / max)", q.angle_deviation_mean, q.angle_deviation_p95,
+                               q.angle_deviation_max) +
+                        ", " + std::to_string(q.flipped_quads) + " flipped, " + std::to_string(q.degenerate_quads) +
+                        " degenerate, " + std::to_string(q.inverted_corners) + " inverted and " +
+                        std::to_string(q.sharp_corners) + " sharp corners";
+  if (q.hausdorff_measured) message += format(", Hausdorff %.3f %% of the diagonal", q.hausdorff_percent);
+  report("quality", message);
+}
 }  // namespace
+
+void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, const QuadRemeshOptions& options,
+                       const QuadProgress& progress) {
+  const auto report = [&](const std::string& stage, const std::string& message) {
+    if (progress) progress(stage, message);
+  };
+  // Corners turned against the quad (non-convex quads, a negative Jacobian there) and sharp ones
+  // (nearly shut or flat, options.quality.sharp_degrees from 90°): the vertices of those quads
+  // moved, and patches round them laid out again, while that lowers (bad quads, inverted corners,
+  // sharp corners) in that order; first with the fitted corners held, then, for inverted corners
+  // left, with those free too. Kept when it lowers them and the quads miss the model no farther
+  // (1 % slack for the sampling); when they do miss farther, the moved vertices near the farthest
+  // misses are held and it is tried again (at most kInvertedTries times). Not kept at all: the
+  // same for the inverted corners alone.
+  if (options.untangle.passes > 0) {
+    QuadQualityOptions topology_only = options.quality;
+    topology_only.hausdorff = false;
+    const QuadQuality before = measure_quads(result.mesh, model, result.grid.corners, topology_only);
+    const auto corner_badness = [](const QuadQuality& q) {
+      return std::make_tuple(q.flipped_quads + q.degenerate_quads, q.inverted_corners, q.sharp_corners);
+    };
+    if (before.inverted_corners > 0 || before.sharp_corners > 0) {
+      const auto begin = std::chrono::steady_clock::now();
+      const double diagonal = bounding_box(model.surface().V).diagonal();
+      const HausdorffOptions sampling = options.quality.sampling;
+      // (result.quality is of result.mesh when measured: remesh_quads measures after this.)
+      const double miss_before = result.quality.hausdorff_measured
+                                     ? result.quality.hausdorff
+                                     : hausdorff_distance(triangulate_quads(result.mesh), model.sampled(), sampling).hausdorff;
+      const double bound = options.refine.bound_percent / 100 * diagonal;
+      const int nv = result.mesh.num_vertices();
+      const double size = mean_quad_size(result.mesh);
+      // One mending, with sharp corners counted beyond sharp_degrees (0: not counted); true when kept.
+      const auto mend = [&](double sharp_degrees) {
+        QuadUntangleOptions corners = options.untangle;
+        corners.inverted = true;
+        corners.sharp_degrees = sharp_degrees;
+        QuadUntangleOptions tangles = corners;  // for the fitted corners: tangles only
+        tangles.sharp_degrees = 0;
+        QuadQualityOptions counted = topology_only;
+        counted.sharp_degrees = sharp_degrees > 0 ? sharp_degrees : 180;
+        const QuadQuality was = measure_quads(result.mesh, model, result.grid.corners, counted);
+        std::vector<char> held(nv, 0);  // vertices held for the distance
+        for (int attempt = 0; attempt < kInvertedTries; ++attempt) {
+          std::vector<char> pinned = held;
+          for (int v = 0; v < nv && v < static_cast<int>(result.fitting.pinned.size()); ++v)
+            pinned[v] = pinned[v] || result.fitting.pinned[v];
+          QuadUntangleResult fixed = untangle_quads(result.mesh, model, corners, pinned);
+          QuadQuality after = measure_quads(fixed.mesh, model, result.grid.corners, counted);
+          if (after.inverted_corners > 0 && pinned != held) {
+            // Some are at fitted corners: those free too, for the inverted corners only (a sharp
+            // corner is not worth moving a vertex off the tip it was fitted to).
+            const int moves = fixed.moves, patches = fixed.patches;
+            fixed = untangle_quads(fixed.mesh, model, tangles, held);
+            fixed.moves += moves;
+            fixed.patches += patches;
+            after = measure_quads(fixed.mesh, model, result.grid.corners, counted);
+          }
+          if (!(corner_badness(after) < corner_badness(was))) return false;
+          const HausdorffDistance miss = hausdorff_distance(triangulate_quads(fixed.mesh), model.sampled(), sampling);
+          // No farther (the slack), and not out of the bound when within it.
+          const bool kept = miss.hausdorff <= kInvertedSlack * miss_before && (miss.hausdorff <= bound || miss_before > bound);
+          std::string what = std::to_string(was.inverted_corners) + " inverted";
+          if (sharp_degrees > 0) what += " and " + std::to_string(was.sharp_corners) + " sharp";
+          what += " corners -> " + std::to_string(after.inverted_corners);
+          if (sharp_degrees > 0) what += " and " + std::to_string(after.sharp_corners);
+          report("untangle", what + " (" + std::to_string(fixed.moves) + " moves, " + std::to_string(fixed.patches) +
+                                 " patches; misses the model by " +
+                                 format("%.3f -> %.3f %% of the diagonal): ", 100 * miss_before / diagonal,
+                                        100 * miss.hausdorff / diagonal) +
+                                 (kept ? "kept" : "not kept"));
+          if (kept) {
+            result.mesh = std::move(fixed.mesh);
+            result.untangling.moves += fixed.moves;
+            result.untangling.patches += fixed.patches;
+            return true;
+          }
+          // Hold the moved vertices near where the quads now miss the model most.
+          int newly = 0;
+          for (int v = 0; v < nv; ++v) {
+            if (held[v] || fixed.mesh.V.row(v) == result.mesh.V.row(v)) continue;
+            const Eigen::Vector3d p = result.mesh.V.row(v).transpose();
+            if ((p - miss.a_farthest).norm() <= kInvertedHoldRadius * size ||
+                (p - miss.b_farthest).norm() <= kInvertedHoldRadius * size) {
+              held[v] = 1;
+              ++newly;
+            }
+          }
+          if (newly == 0) return false;
+        }
+        return false;
+      };
+      // Sharp corners too; if that is not kept, inverted corners alone.
+      if (!mend(options.quality.sharp_degrees) && before.inverted_corners > 0 && options.quality.sharp_degrees > 0) mend(0);
+      result.seconds_untangle += since(begin);
+    }
+  }
+  if (options.measure) measure_result(result, model, options, report);
+}
 
 QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_model, const SurfaceProjector& model,
                               const QuadRemeshOptions& options, const QuadProgress& progress) {
@@ -508,110 +626,10 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
       result.seconds_untangle += since(begin);
     }
   }
-  // Corners turned against the quad (non-convex quads, a negative Jacobian there) and sharp ones
-  // (nearly shut or flat, options.quality.sharp_degrees from 90°): the vertices of those quads
-  // moved, and patches round them laid out again, while that lowers (bad quads, inverted corners,
-  // sharp corners) in that order; first with the fitted corners held, then, for inverted corners
-  // left, with those free too. Kept when it lowers them and the quads miss the model no farther
-  // (1 % slack for the sampling); when they do miss farther, the moved vertices near the farthest
-  // misses are held and it is tried again (at most kInvertedTries times). Not kept at all: the
-  // same for the inverted corners alone.
-  if (options.untangle.passes > 0 && options.mend_corners) {
-    QuadQualityOptions topology_only = options.quality;
-    topology_only.hausdorff = false;
-    const QuadQuality before = measure_quads(result.mesh, model, result.grid.corners, topology_only);
-    const auto corner_badness = [](const QuadQuality& q) {
-      return std::make_tuple(q.flipped_quads + q.degenerate_quads, q.inverted_corners, q.sharp_corners);
-    };
-    if (before.inverted_corners > 0 || before.sharp_corners > 0) {
-      const auto begin = std::chrono::steady_clock::now();
-      const double diagonal = bounding_box(model.surface().V).diagonal();
-      const HausdorffOptions sampling = options.quality.sampling;
-      const double miss_before = hausdorff_distance(triangulate_quads(result.mesh), model.sampled(), sampling).hausdorff;
-      const int nv = result.mesh.num_vertices();
-      const double size = mean_quad_size(result.mesh);
-      // One mending, with sharp corners counted beyond sharp_degrees (0: not counted); true when kept.
-      const auto mend = [&](double sharp_degrees) {
-        QuadUntangleOptions corners = options.untangle;
-        corners.inverted = true;
-        corners.sharp_degrees = sharp_degrees;
-        QuadUntangleOptions tangles = corners;  // for the fitted corners: tangles only
-        tangles.sharp_degrees = 0;
-        QuadQualityOptions counted = topology_only;
-        counted.sharp_degrees = sharp_degrees > 0 ? sharp_degrees : 180;
-        const QuadQuality was = measure_quads(result.mesh, model, result.grid.corners, counted);
-        std::vector<char> held(nv, 0);  // vertices held for the distance
-        for (int attempt = 0; attempt < kInvertedTries; ++attempt) {
-          std::vector<char> pinned = held;
-          for (int v = 0; v < nv && v < static_cast<int>(result.fitting.pinned.size()); ++v)
-            pinned[v] = pinned[v] || result.fitting.pinned[v];
-          QuadUntangleResult fixed = untangle_quads(result.mesh, model, corners, pinned);
-          QuadQuality after = measure_quads(fixed.mesh, model, result.grid.corners, counted);
-          if (after.inverted_corners > 0 && pinned != held) {
-            // Some are at fitted corners: those free too, for the inverted corners only (a sharp
-            // corner is not worth moving a vertex off the tip it was fitted to).
-            const int moves = fixed.moves, patches = fixed.patches;
-            fixed = untangle_quads(fixed.mesh, model, tangles, held);
-            fixed.moves += moves;
-            fixed.patches += patches;
-            after = measure_quads(fixed.mesh, model, result.grid.corners, counted);
-          }
-          if (!(corner_badness(after) < corner_badness(was))) return false;
-          const HausdorffDistance miss = hausdorff_distance(triangulate_quads(fixed.mesh), model.sampled(), sampling);
-          const bool kept = miss.hausdorff <= kInvertedSlack * miss_before;
-          std::string what = std::to_string(was.inverted_corners) + " inverted";
-          if (sharp_degrees > 0) what += " and " + std::to_string(was.sharp_corners) + " sharp";
-          what += " corners -> " + std::to_string(after.inverted_corners);
-          if (sharp_degrees > 0) what += " and " + std::to_string(after.sharp_corners);
-          report("untangle", what + " (" + std::to_string(fixed.moves) + " moves, " + std::to_string(fixed.patches) +
-                                 " patches; misses the model by " +
-                                 format("%.3f -> %.3f %% of the diagonal): ", 100 * miss_before / diagonal,
-                                        100 * miss.hausdorff / diagonal) +
-                                 (kept ? "kept" : "not kept"));
-          if (kept) {
-            result.mesh = std::move(fixed.mesh);
-            result.untangling.moves += fixed.moves;
-            result.untangling.patches += fixed.patches;
-            return true;
-          }
-          // Hold the moved vertices near where the quads now miss the model most.
-          int newly = 0;
-          for (int v = 0; v < nv; ++v) {
-            if (held[v] || fixed.mesh.V.row(v) == result.mesh.V.row(v)) continue;
-            const Eigen::Vector3d p = result.mesh.V.row(v).transpose();
-            if ((p - miss.a_farthest).norm() <= kInvertedHoldRadius * size ||
-                (p - miss.b_farthest).norm() <= kInvertedHoldRadius * size) {
-              held[v] = 1;
-              ++newly;
-            }
-          }
-          if (newly == 0) return false;
-        }
-        return false;
-      };
-      // Sharp corners too; if that is not kept, inverted corners alone.
-      if (!mend(options.quality.sharp_degrees) && before.inverted_corners > 0 && options.quality.sharp_degrees > 0) mend(0);
-      result.seconds_untangle += since(begin);
-    }
-  }
-  const PolycubeGrid& grid = result.grid;
-
-  if (options.measure) {
-    report("quality", options.quality.hausdorff ? "angles, flips, Hausdorff distance" : "angles, flips");
-    start = std::chrono::steady_clock::now();
-    result.quality = measure_quads(result.mesh, model, grid.corners, options.quality);
-    result.seconds_quality = since(start);
-    const QuadQuality& q = result.quality;
-    std::string message = std::to_string(q.quads) + " quads, " + std::to_string(q.irregular_vertices) + " irregular (" +
-                          std::to_string(q.irregular_at_corners) + " at polycube corners), angle deviation " +
-                          format("%.2f / %.2f / %.1f deg (mean / p95 / max)", q.angle_deviation_mean, q.angle_deviation_p95,
-                                 q.angle_deviation_max) +
-                          ", " + std::to_string(q.flipped_quads) + " flipped, " + std::to_string(q.degenerate_quads) +
-                          " degenerate, " + std::to_string(q.inverted_corners) + " inverted and " +
-                          std::to_string(q.sharp_corners) + " sharp corners";
-    if (q.hausdorff_measured) message += format(", Hausdorff %.3f %% of the diagonal", q.hausdorff_percent);
-    report("quality", message);
-  }
+  if (options.mend_corners)
+    mend_quad_corners(result, model, options, progress);  // measures too
+  else if (options.measure)
+    measure_result(result, model, options, report);
   return result;
 }
 

@@ -110,4 +110,12 @@ struct QuadRemeshResult {
 QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_model, const SurfaceProjector& model,
                               const QuadRemeshOptions& options = {}, const QuadProgress& progress = {});
 
+// The corners' mending of remesh_quads (QuadRemeshOptions::mend_corners) on its result, on its
+// own (`polycube quad` mends only the try it keeps): quads with inverted or sharp corners
+// untangled, kept when that raises neither the bad quads nor the inverted corners nor the
+// Hausdorff distance (beyond 1 %, and not out of options.refine.bound_percent); then, when
+// options.measure, result.quality measured again. The mesh keeps its connectivity.
+void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, const QuadRemeshOptions& options = {},
+                       const QuadProgress& progress = {});
+
 }  // namespace polycube
