@@ -6,7 +6,8 @@ Usage: bench/quad_bench.py [--binary build/polycube] [--output bench/quad-table.
 
 Default meshes: every mesh of ../shared/data/paper and ../shared/data/dev when present
 (laurana-open with --fill-holes). Per mesh, from the --report JSON: quads, irregular vertices and
-P's cone points, the refinement's rounds, halved chord parts and template rounds, angle deviation from 90° (mean / p95 / max), flipped quads / inverted corners / sharp corners (beyond 60° from square),
+P's cone points, the refinement's rounds, halved chord parts and template rounds, angle deviation from 90° (mean / p95 / max), flipped quads / inverted corners / sharp corners (beyond 60° from square; before → after the
+mending of the corners when it ran),
 degenerate quads, the Hausdorff distance (% of the diagonal, both one-sided distances), the fit's
 pulled corners, the triangles the map was built on (the model's long edges split: rounds), seconds
 per stage, wall time and peak RSS (/usr/bin/time). Standard library only.
@@ -25,6 +26,13 @@ def run(binary, mesh, extra):
     report_path = os.path.join(out, "report.json")
     return run_command([binary, "quad", mesh, "-o", os.path.join(out, "quads.obj"), "--report", report_path, "--quiet"] + extra,
                        mesh, report_path)
+
+
+def mended(r, what):
+    """The inverted or sharp corners, "before → after" the mending of the corners when it ran."""
+    q, c = r["quality"], r.get("corners_mended")
+    after = q.get(what + "_corners", "–")
+    return "%d→%s" % (c[what + "_before"], after) if c else str(after)
 
 
 def main():
@@ -52,9 +60,9 @@ def main():
         stages = " / ".join("%.2f" % s.get(k, 0) for k in stage_names)
         g = r.get("grid", {})
         split = r.get("split", {})
-        rows.append("| %s | %d | %d / %d / %d | %d | %d | %.2f / %.1f / %.1f | %d / %d / %s | %d | %.3f (%.3f / %.3f) | %d | %s | %s | %.2f | %.2f | %.0f |" % (
+        rows.append("| %s | %d | %d / %d / %d | %d | %d | %.2f / %.1f / %.1f | %d / %s / %s | %d | %.3f (%.3f / %.3f) | %d | %s | %s | %.2f | %.2f | %.0f |" % (
             name, q["quads"], g.get("refine_rounds", 0), g.get("refined_chord_parts", 0), g.get("template_rounds", 0), q["irregular_vertices"], q["irregular_at_corners"], ang["mean"], ang["p95"], ang["max"],
-            q["flipped_quads"], q["inverted_corners"], q.get("sharp_corners", "–"), q["degenerate_quads"], q["hausdorff_percent_diagonal"],
+            q["flipped_quads"], mended(r, "inverted"), mended(r, "sharp"), q["degenerate_quads"], q["hausdorff_percent_diagonal"],
             100 * sides["quads_to_model"] / diag, 100 * sides["model_to_quads"] / diag,
             r.get("fitting", {}).get("snapped", 0),
             "%d (%d)" % (split["triangles"], split["rounds"]) if split else "-", stages, s["total"], wall, rss))

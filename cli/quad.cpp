@@ -577,6 +577,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                             {"flipped_after", result.untangling.flipped_after},
                             {"moves", result.untangling.moves},
                             {"patches", result.untangling.patches}};
+    if (result.inverted_before_mending >= 0)
+      report["corners_mended"] = {{"inverted_before", result.inverted_before_mending},
+                                  {"sharp_before", result.sharp_before_mending},
+                                  {"inverted_after", q.inverted_corners},
+                                  {"sharp_after", q.sharp_corners},
+                                  {"tries", result.mending_tries},
+                                  {"kept", result.mending_kept}};
     report["quality"] = quality_json(q);
     // Where the flipped and degenerate quads are (the first 20), to find them in a viewer.
     nlohmann::json bad = nlohmann::json::array();

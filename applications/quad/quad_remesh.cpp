@@ -92,6 +92,8 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
     QuadQualityOptions topology_only = options.quality;
     topology_only.hausdorff = false;
     const QuadQuality before = measure_quads(result.mesh, model, result.grid.corners, topology_only);
+    result.inverted_before_mending = before.inverted_corners;
+    result.sharp_before_mending = before.sharp_corners;
     const auto corner_badness = [](const QuadQuality& q) {
       return std::make_tuple(q.flipped_quads + q.degenerate_quads, q.inverted_corners, q.sharp_corners);
     };
@@ -121,6 +123,7 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
           std::vector<char> pinned = held;
           for (int v = 0; v < nv && v < static_cast<int>(result.fitting.pinned.size()); ++v)
             pinned[v] = pinned[v] || result.fitting.pinned[v];
+          ++result.mending_tries;
           QuadUntangleResult fixed = untangle_quads(result.mesh, model, corners, pinned);
           QuadQuality after = measure_quads(fixed.mesh, model, result.grid.corners, counted);
           if (after.inverted_corners > 0 && pinned != held) {
@@ -146,6 +149,7 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
                                         100 * miss.hausdorff / diagonal) +
                                  (kept ? "kept" : "not kept"));
           if (kept) {
+            result.mending_kept = true;
             result.mesh = std::move(fixed.mesh);
             result.untangling.moves += fixed.moves;
             result.untangling.patches += fixed.patches;

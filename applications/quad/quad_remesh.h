@@ -91,6 +91,11 @@ struct QuadRemeshResult {
   QuadFitResult fitting;
   QuadSmoothResult refitting;
   QuadUntangleResult untangling;
+  // What the corners' mending found and left (mend_quad_corners; -1: it did not run), how many
+  // tries it made and whether one was kept.
+  int inverted_before_mending = -1, sharp_before_mending = -1;
+  int mending_tries = 0;
+  bool mending_kept = false;
   QuadQuality quality;
   double seconds_grid = 0;
   double seconds_carry = 0;

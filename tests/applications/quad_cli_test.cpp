@@ -108,6 +108,13 @@ TEST(QuadCli, SameQuadsOnOneThreadOrThree) {
   EXPECT_EQ(one, three) << "the quads written differ";
   EXPECT_EQ(one_report["quality"], three_report["quality"]);
   EXPECT_EQ(one_report["grid"], three_report["grid"]);
+  // The corners' mending on the kept try: the same either way, and its counts are the report's.
+  ASSERT_TRUE(one_report.contains("corners_mended"));
+  EXPECT_EQ(one_report["corners_mended"], three_report["corners_mended"]);
+  const nlohmann::json& mended = one_report["corners_mended"];
+  EXPECT_EQ(mended["inverted_after"], one_report["quality"]["inverted_corners"]);
+  EXPECT_EQ(mended["sharp_after"], one_report["quality"]["sharp_corners"]);
+  EXPECT_LE(mended["inverted_after"].get<int>(), mended["inverted_before"].get<int>());
   EXPECT_EQ(polycube_cli("quad " + quoted(test::data_path("eight.off")) + " -o " + quoted(dir + "/q.obj") + " --threads -1").code, 2);
 }
 
