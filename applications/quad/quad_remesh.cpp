@@ -32,12 +32,12 @@ constexpr double kExtendedRoundGrowth = 1.2;
 // Once a round's place cut a line by a bad quad, places within this many times the quad's size
 // on P (centre to farthest corner) of it are not refined again.
 constexpr double kBlockRadius = 3;
-// The mending of inverted corners at the end: tries, the distance slack (the quads may miss the
+// The mending of inverted and sharp corners at the end: tries, the distance slack (the quads may miss the
 // model by this factor of before), and the radius, in mean quad sizes, round the farthest misses
 // within which moved vertices are held for the next try.
-constexpr int kInvertedTries = 4;
-constexpr double kInvertedSlack = 1.01;
-constexpr double kInvertedHoldRadius = 3;
+constexpr int kMendTries = 4;
+constexpr double kMendSlack = 1.01;
+constexpr double kMendHoldRadius = 3;
 
 // A pass's quads and what made them, into `to` (whose stage times and refinement figures stay).
 void take_pass(QuadRemeshResult& to, QuadRemeshResult pass) {
@@ -86,7 +86,7 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
   // sharp corners) in that order; first with the fitted corners held, then, for inverted corners
   // left, with those free too. Kept when it lowers them and the quads miss the model no farther
   // (1 % slack for the sampling); when they do miss farther, the moved vertices near the farthest
-  // misses are held and it is tried again (at most kInvertedTries times). Not kept at all: the
+  // misses are held and it is tried again (at most kMendTries times). Not kept at all: the
   // same for the inverted corners alone.
   if (options.untangle.passes > 0) {
     QuadQualityOptions topology_only = options.quality;
@@ -119,7 +119,7 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
         counted.sharp_degrees = sharp_degrees > 0 ? sharp_degrees : 180;
         const QuadQuality was = measure_quads(result.mesh, model, result.grid.corners, counted);
         std::vector<char> held(nv, 0);  // vertices held for the distance
-        for (int attempt = 0; attempt < kInvertedTries; ++attempt) {
+        for (int attempt = 0; attempt < kMendTries; ++attempt) {
           std::vector<char> pinned = held;
           for (int v = 0; v < nv && v < static_cast<int>(result.fitting.pinned.size()); ++v)
             pinned[v] = pinned[v] || result.fitting.pinned[v];
@@ -138,7 +138,7 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
           if (!(corner_badness(after) < corner_badness(was))) return false;
           const HausdorffDistance miss = hausdorff_distance(triangulate_quads(fixed.mesh), model.sampled(), sampling);
           // No farther (the slack), and not out of the bound when within it.
-          const bool kept = miss.hausdorff <= kInvertedSlack * miss_before && (miss.hausdorff <= bound || miss_before > bound);
+          const bool kept = miss.hausdorff <= kMendSlack * miss_before && (miss.hausdorff <= bound || miss_before > bound);
           std::string what = std::to_string(was.inverted_corners) + " inverted";
           if (sharp_degrees > 0) what += " and " + std::to_string(was.sharp_corners) + " sharp";
           what += " corners -> " + std::to_string(after.inverted_corners);
@@ -160,8 +160,8 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
           for (int v = 0; v < nv; ++v) {
             if (held[v] || fixed.mesh.V.row(v) == result.mesh.V.row(v)) continue;
             const Eigen::Vector3d p = result.mesh.V.row(v).transpose();
-            if ((p - miss.a_farthest).norm() <= kInvertedHoldRadius * size ||
-                (p - miss.b_farthest).norm() <= kInvertedHoldRadius * size) {
+            if ((p - miss.a_farthest).norm() <= kMendHoldRadius * size ||
+                (p - miss.b_farthest).norm() <= kMendHoldRadius * size) {
               held[v] = 1;
               ++newly;
             }
