@@ -97,7 +97,7 @@ QuadQuality measure_quads(const QuadMesh& quads, const SurfaceProjector& referen
       longest = std::max(longest, next.norm());
       const double angle = std::atan2(next.cross(previous).norm(), next.dot(previous)) * kDegrees;
       deviation.push_back(std::abs(angle - 90));
-      r.sharp_corners += deviation.back() > options.sharp_degrees;
+      r.sharp_corners += sharp_corner(next, previous, options.sharp_degrees);
       if (next.cross(previous).dot(c.normal) <= 0) ++r.inverted_corners;
     }
     const double aspect = shortest > 0 ? longest / shortest : INFINITY;

@@ -6,6 +6,7 @@
 #include "applications/quad/surface_projector.h"
 #include "polycube/polycube_distance.h"
 
+#include <cmath>
 #include <vector>
 
 namespace polycube {
@@ -83,6 +84,14 @@ Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const Eigen
 // the mean of the corners), so callers can pass search hints.
 inline Eigen::Vector3d quad_surface_normal(const SurfaceProjector& surface, const SurfaceHit& centre) {
   return surface.face_normal(centre.face);
+}
+
+// Whether the corner between edges a and b (from the corner to its two neighbours) is sharp: its
+// angle more than sharp_degrees from 90° either way (measure_quads' sharp_corners; false for an
+// edge of length 0 or sharp_degrees <= 0).
+inline bool sharp_corner(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double sharp_degrees) {
+  const double lengths = a.norm() * b.norm();
+  return sharp_degrees > 0 && lengths > 0 && std::abs(a.dot(b)) > std::sin(sharp_degrees * M_PI / 180) * lengths;
 }
 
 // The quads measure_quads counts as flipped or degenerate, by index.

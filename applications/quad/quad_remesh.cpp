@@ -91,7 +91,9 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
   if (options.untangle.passes > 0) {
     QuadQualityOptions topology_only = options.quality;
     topology_only.hausdorff = false;
-    const QuadQuality before = measure_quads(result.mesh, model, result.grid.corners, topology_only);
+    // (result.quality, when measured, is of result.mesh: remesh_quads measures after this.)
+    const bool measured = result.quality.quads == result.mesh.num_quads() && result.quality.quads > 0;
+    const QuadQuality before = measured ? result.quality : measure_quads(result.mesh, model, result.grid.corners, topology_only);
     result.inverted_before_mending = before.inverted_corners;
     result.sharp_before_mending = before.sharp_corners;
     const auto corner_badness = [](const QuadQuality& q) {
@@ -101,8 +103,7 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
       const auto begin = std::chrono::steady_clock::now();
       const double diagonal = bounding_box(model.surface().V).diagonal();
       const HausdorffOptions sampling = options.quality.sampling;
-      // (result.quality is of result.mesh when measured: remesh_quads measures after this.)
-      const double miss_before = result.quality.hausdorff_measured
+      const double miss_before = measured && result.quality.hausdorff_measured
                                      ? result.quality.hausdorff
                                      : hausdorff_distance(triangulate_quads(result.mesh), model.sampled(), sampling).hausdorff;
       const double bound = options.refine.bound_percent / 100 * diagonal;
@@ -117,7 +118,8 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
         tangles.sharp_degrees = 0;
         QuadQualityOptions counted = topology_only;
         counted.sharp_degrees = sharp_degrees > 0 ? sharp_degrees : 180;
-        const QuadQuality was = measure_quads(result.mesh, model, result.grid.corners, counted);
+        const QuadQuality was =
+            sharp_degrees == options.quality.sharp_degrees ? before : measure_quads(result.mesh, model, result.grid.corners, counted);
         std::vector<char> held(nv, 0);  // vertices held for the distance
         for (int attempt = 0; attempt < kMendTries; ++attempt) {
           std::vector<char> pinned = held;

@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <map>
 #include <set>
 #include <stdexcept>
@@ -295,7 +294,6 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
   const auto worked_on = [&](const Badness& b) {
     return b.bad() || (options.inverted && b.inverted > 0) || b.sharp > 0;
   };
-  const double cos_limit = options.sharp_degrees > 0 ? std::sin(options.sharp_degrees * M_PI / 180) : 2;
   const auto badness = [&](int q) {
     SurfaceHit centre;
     const int bits = guard.state(q, centre, size);
@@ -310,13 +308,10 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
     const Eigen::Vector3d d2 = mesh.V.row(mesh.Q(q, 3)) - mesh.V.row(mesh.Q(q, 1));
     b.collapsed = b.collapsed || d1.cross(d2).norm() / 2 <= std::max(shortest * shortest, degenerate_area);
     if (!options.collapsed) b.collapsed = 0;
-    if (cos_limit <= 1)
-      for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector3d a = mesh.V.row(mesh.Q(q, (k + 1) % 4)) - mesh.V.row(mesh.Q(q, k));
-        const Eigen::Vector3d c = mesh.V.row(mesh.Q(q, (k + 3) % 4)) - mesh.V.row(mesh.Q(q, k));
-        const double lengths = a.norm() * c.norm();
-        b.sharp += lengths > 0 && std::abs(a.dot(c)) > cos_limit * lengths;
-      }
+    if (options.sharp_degrees > 0)
+      for (int k = 0; k < 4; ++k)
+        b.sharp += sharp_corner(mesh.V.row(mesh.Q(q, (k + 1) % 4)) - mesh.V.row(mesh.Q(q, k)),
+                                mesh.V.row(mesh.Q(q, (k + 3) % 4)) - mesh.V.row(mesh.Q(q, k)), options.sharp_degrees);
     return b;
   };
   std::vector<Badness> state(nq);
