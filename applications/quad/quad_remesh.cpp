@@ -153,6 +153,7 @@ void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, 
           if (kept) {
             result.mending_kept = true;
             result.mesh = std::move(fixed.mesh);
+            result.quality = QuadQuality{};  // not of this mesh any more (measured below if asked)
             result.untangling.moves += fixed.moves;
             result.untangling.patches += fixed.patches;
             return true;

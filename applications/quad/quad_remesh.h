@@ -119,7 +119,9 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
 // own (`polycube quad` mends only the try it keeps): quads with inverted or sharp corners
 // untangled, kept when that raises neither the bad quads nor the inverted corners nor the
 // Hausdorff distance (beyond 1 %, and not out of options.refine.bound_percent); then, when
-// options.measure, result.quality measured again. The mesh keeps its connectivity.
+// options.measure, result.quality measured again (else, if the mesh changed, left unmeasured:
+// result.quality is reused as the starting figures only when it is of result.mesh). The mesh
+// keeps its connectivity.
 void mend_quad_corners(QuadRemeshResult& result, const SurfaceProjector& model, const QuadRemeshOptions& options = {},
                        const QuadProgress& progress = {});
 
