@@ -45,6 +45,7 @@ struct MapOptions {
   std::string output_dir;
   std::string stage = kStages.back();
   std::string align = "auto";
+  std::string separate = "always";
   int smooth_sweeps = 10;
   bool refine = true;
   // The last untangling's largest move of an image, × the target's diagonal; 0: none.
@@ -468,6 +469,14 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   report["parameters"]["untangle_shift_max"] = options.untangle_shift_max;
   report["parameters"]["finer_contours"] = options.finer_contours;
   std::vector<std::string> outputs;
+  // Self-intersecting: every stage runs on the separated copy; the images on it go back to the
+  // model at the end, and the audit is made again there.
+  Separation separation;
+  if (options.separate == "always")
+    separation = separated_for_stages(prepared, progress, report);
+  else
+    separation.mesh = prepared.mesh;
+  const TriMesh& source = separation.mesh;
 
   // The pipeline runs on the model turned into the chosen frame; outputs go back to the input's.
   // One pass: the orientation search (with --align auto) and the finished maps of its candidates
@@ -485,7 +494,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     if (pass.align == "auto" && pass.stage != "topology") {
       const double align_start = progress.elapsed_seconds();
       progress.stage("align", "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 2 with fewest corners (the rest if both flip), scored by flips");
-      alignment = choose_alignment(prepared.mesh, pass.topology, pass.polycube);
+      alignment = choose_alignment(source, pass.topology, pass.polycube);
       nlohmann::json candidates = nlohmann::json::array();
       for (const AlignmentCandidate& c : alignment.candidates)
         candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle}, {"eps_area", c.eps_area},
@@ -513,7 +522,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     for (size_t i = first; i < attempts.size(); ++i) {
       Attempt& a = *attempts[i];
       if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
-      run_stages(a, prepared.mesh, pass, progress);
+      run_stages(a, source, pass, progress);
       if (!a.finished) {
         kept = &a;
         return;
@@ -577,6 +586,29 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       a->seconds += progress.elapsed_seconds() - start;
       if (a->finished->rank() < kept->finished->rank()) kept = a;
       if (kept->finished->meets_contract()) break;
+    }
+  }
+  if (separation.rounds > 0 && kept->finished) {
+    // P's images on the copy, moved to the same faces and barycentric coordinates of the model,
+    // and audited there (the audit on the copy goes to the report).
+    Finished& finished = *kept->finished;
+    report["separation"]["on_copy"] = {{"polycube_to_model", direction_json(finished.audit.polycube_to_model)},
+                                       {"model_to_polycube", direction_json(finished.audit.model_to_polycube)},
+                                       {"eps_angle", finished.audit.distortion.eps_angle}};
+    const TriMesh turned = rotated(prepared.mesh, kept->rotation);
+    finished.on_model_xyz = to_original_surface(kept->model, turned, finished.on_model_xyz);
+    finished.audit = audit_map(turned, finished.polycube->mesh, finished.on_model_xyz, finished.on_polycube_xyz);
+    progress.stage("separate", "P's images moved back to the model: " + std::to_string(finished.bad_p()) + " / " +
+                                   std::to_string(finished.bad_m()) + " flipped or degenerate image triangles (P to M / M to P)");
+    // Where the model's own sheets pass near each other, an image triangle can turn against the
+    // surface under it: the same untangling as the finished map's, on the model.
+    const nlohmann::json untangling_on_copy = finished.untangling;
+    const double untangle_seconds_on_copy = finished.untangle_seconds;
+    untangle_images(turned, finished, options.untangle_shift, options.untangle_shift_max, progress);
+    if (finished.untangle_seconds != untangle_seconds_on_copy) {
+      report["separation"]["untangling"] = finished.untangling;
+      finished.untangling = untangling_on_copy;
+      finished.untangle_seconds += untangle_seconds_on_copy;
     }
   }
   const Attempt& chosen = *kept;
@@ -757,6 +789,12 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "fewest flipped triangles; none: keep the input's orientation")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "none"}));
+  command->add_option("--separate", options->separate,
+                      "A model that intersects itself: always: build everything on a copy pulled apart round the crossings "
+                      "(local smoothing; a cutting plane's contours must not cross), P's images moved back onto the model at the "
+                      "end and audited there; never: on the model itself")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"always", "never"}));
   command->add_option("--smooth-sweeps", options->smooth_sweeps,
                       "Sweeps per round of the map's smoothing (paper §3.5; never adds a flipped triangle); 0: no smoothing")
       ->capture_default_str()

@@ -24,6 +24,25 @@ PreparedMesh load_mesh(const MeshInput& input, const Progress& progress) {
   return prepared;
 }
 
+Separation separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report) {
+  if (prepared.diagnosis.self_intersections <= 0) {
+    Separation none;
+    none.mesh = prepared.mesh;
+    return none;
+  }
+  progress.stage("separate", "the model intersects itself: smoothing round the crossings, on a copy the planes cut");
+  Separation s = separate_self_intersections(prepared.mesh);
+  progress.stage("separate", std::to_string(s.pairs_before) + " face pairs apart after " + std::to_string(s.rounds) + " rounds; " +
+                                 std::to_string(s.moved_vertices) + " vertices moved, by up to " +
+                                 std::to_string(100 * s.max_shift) + " % of the diagonal");
+  report["separation"] = {{"pairs_before", s.pairs_before},
+                          {"rounds", s.rounds},
+                          {"moved_vertices", s.moved_vertices},
+                          {"max_shift", s.max_shift},
+                          {"seconds", s.seconds}};
+  return s;
+}
+
 nlohmann::json diagnosis_json(const PreparedMesh& prepared) {
   const MeshDiagnosis& d = prepared.diagnosis;
   nlohmann::json j;

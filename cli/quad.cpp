@@ -49,6 +49,7 @@ struct QuadCommandOptions {
   std::string report_path;
   std::string preview_path;
   std::string align = "auto";
+  std::string separate = "auto";
   int smooth_map_sweeps = 0;
   // Quads that still fall short are tried once more with d_a divided by this (as `map` does; a
   // try with more than refine_bound_growth × target_faces quads is not kept then); 1: never.
@@ -176,6 +177,7 @@ struct QuadModel {
   const TriMesh* mesh = nullptr;
   const TriMesh* sampled = nullptr;  // the model as read, when mesh is its split copy
   bool split = false;
+  const Separation* separation = nullptr;  // mesh is this separated copy (or its split copy)
   // Built on first use: the model as read's is needed only when a search runs on it (or --map).
   std::shared_ptr<const SurfaceProjector> projector() const {
     if (!projector_)
@@ -222,14 +224,17 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   }
   const PreparedMesh prepared = load_mesh(options.input, progress);
   require_mappable(prepared.diagnosis);
+  nlohmann::json report;
   const double read_seconds = progress.elapsed_seconds();
   // The map is built on the model with its long edges split (same surface): a coarse model's
   // harmonic disk maps have too few interior vertices and shear the quads carried through them
   // (tetrahedron: 35 deg mean angle deviation). Not with --map: that map is of the model as read.
+  const auto split_cell = [&options](const TriMesh& mesh) {
+    return options.cell_size > 0 ? options.cell_size : std::sqrt(surface_area(mesh) / options.target_faces);
+  };
   SplitLongEdges split;
   if (options.map_dir.empty() && options.split_edges > 0) {
-    const double cell = options.cell_size > 0 ? options.cell_size : std::sqrt(surface_area(prepared.mesh) / options.target_faces);
-    split = split_long_edges(prepared.mesh, options.split_edges * cell, kSplitEdgesMaxFaces);
+    split = split_long_edges(prepared.mesh, options.split_edges * split_cell(prepared.mesh), kSplitEdgesMaxFaces);
     if (split.rounds > 0)
       progress.stage("split", std::to_string(split.rounds) + " rounds of long edges split: " + std::to_string(split.mesh.num_faces()) +
                                   " triangles" + (split.capped ? " (capped)" : ""));
@@ -246,8 +251,29 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   split_copy.sampled = &prepared.mesh;
   split_copy.split = true;
   const QuadModel& split_model = split.rounds > 0 ? split_copy : as_read;
+  // A self-intersecting model none of whose orientations gives a polycube (a cutting plane's
+  // contours cross): the search again on its separated copy (separate.h; made when first needed,
+  // split as the model is), the quads moved back to the model at the end.
+  Separation separation;
+  SplitLongEdges separated_split;
+  QuadModel separated_as_read, separated_split_copy;
+  const auto separated_of = [&](const QuadModel& on) -> const QuadModel* {
+    if (prepared.diagnosis.self_intersections <= 0 || on.separation || options.separate == "never") return nullptr;
+    if (!separated_as_read.mesh) {
+      separation = separated_for_stages(prepared, progress, report);
+      separated_as_read.mesh = &separation.mesh;
+      separated_as_read.separation = &separation;
+      if (split.rounds > 0) {
+        separated_split = split_long_edges(separation.mesh, options.split_edges * split_cell(separation.mesh), kSplitEdgesMaxFaces);
+        separated_split_copy.mesh = &separated_split.mesh;
+        separated_split_copy.sampled = &separation.mesh;
+        separated_split_copy.split = true;
+        separated_split_copy.separation = &separation;
+      }
+    }
+    return on.split ? &separated_split_copy : &separated_as_read;
+  };
 
-  nlohmann::json report;
   report["input"] = diagnosis_json(prepared);
   report["input"]["file"] = options.input.path;
   report["parameters"] = {{"target_faces", options.cell_size > 0 ? nlohmann::json() : nlohmann::json(options.target_faces)},
@@ -306,9 +332,10 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   }
   // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
   // images are turned back into the input's frame. One search's candidates become attempts.
-  const auto add_attempts = [&](const PolycubeOptions& polycube, nlohmann::json& alignment_report, const std::string& suffix,
-                                const QuadModel& on) {
-    const TriMesh& model = *on.mesh;
+  const auto add_attempts = [&](const PolycubeOptions& polycube, nlohmann::json& alignment_report, std::string suffix,
+                                const QuadModel& given) {
+    const QuadModel* on = &given;
+    const TriMesh& model = *given.mesh;
     Alignment alignment;
     if (options.align == "auto" || options.align == "corners") {
       AlignmentOptions align_options;
@@ -318,6 +345,14 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                                   : "orientations (input frame, principal axes, normal axes): the polycube with the fewest corners");
       const double align_start = progress.elapsed_seconds();
       alignment = choose_alignment(model, options.topology, polycube, align_options);
+      if (alignment.chosen < 0) {
+        if (const QuadModel* copy = separated_of(*on)) {
+          progress.stage("align", "no orientation gives a valid polycube: the search again on the model's separated copy");
+          on = copy;
+          suffix += ", separated copy";
+          alignment = choose_alignment(*on->mesh, options.topology, polycube, align_options);
+        }
+      }
       seconds["align"] = seconds.value("align", 0.0) + progress.elapsed_seconds() - align_start;
       if (alignment.proxy_faces > 0)
         progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
@@ -336,10 +371,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       static_cast<AlignedStages&>(*attempts.back()) = stages;
       attempts.back()->name = (stages.candidate >= 0 ? alignment.candidates[stages.candidate].name : std::string("input frame")) + suffix;
       attempts.back()->polycube_options = polycube;
-      attempts.back()->on = &on;
+      attempts.back()->on = on;
     }
   };
-  if (options.map_dir.empty()) add_attempts(options.polycube, report["alignment"], "", split_model);
+  if (options.map_dir.empty()) {
+    const QuadModel* copy = options.separate == "always" ? separated_of(split_model) : nullptr;
+    add_attempts(options.polycube, report["alignment"], copy ? ", separated copy" : "", copy ? *copy : split_model);
+  }
   // The map stages one orientation still needs, then its quads.
   const auto remesh_with = [&](QuadAttempt& a) {
     const double start = progress.elapsed_seconds();
@@ -466,7 +504,14 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     // The kept try's corners mended (the other tries are only compared).
     QuadRemeshOptions mend = remesh;
     mend.mend_corners = true;
-    mend_quad_corners(*kept->result, *kept->on->projector(), mend, report_stage);
+    const QuadModel* on = kept->on;
+    if (on->separation) {
+      kept->result->mesh.V = to_original_surface(on->separation->mesh, prepared.mesh, kept->result->mesh.V);
+      kept->result->quality = QuadQuality{};  // measured again on the model
+      progress.stage("separate", "the quads moved back to the model from its separated copy");
+      on = on->split ? &split_copy : &as_read;
+    }
+    mend_quad_corners(*kept->result, *on->projector(), mend, report_stage);
   }
   if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;
@@ -667,6 +712,12 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
                       "corners: fewest polycube corners only (no candidate maps, faster); none: the input's orientation")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "corners", "none"}));
+  command->add_option("--separate", options->separate,
+                      "A model that intersects itself (not with --map): auto: when none of its orientations gives a polycube, search "
+                      "again on a copy pulled apart round the crossings (local smoothing), the quads moved back onto the model at the "
+                      "end; always: make the map and the quads on that copy from the start; never: the model only")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "always", "never"}));
   command->add_option("--dz", options->topology.dz, "Largest gap between cutting planes, unit-cube units (paper's d_z; not with --map)")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));

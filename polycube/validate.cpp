@@ -3,9 +3,9 @@
 #include "polycube/cgal_bridge.h"
 #include "polycube/errors.h"
 #include "polycube/mesh_topology.h"
+#include "polycube/separate.h"
 
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
-#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 
 #include <algorithm>
@@ -345,10 +345,7 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
       if (const int flipped = orient_outward(mesh); flipped > 0)
         result.repairs.push_back("reversed the orientation of " + plural(flipped, "face") + " to face outward");
     if (options.check_self_intersections) {
-      const cgal::SurfaceMesh sm = cgal::to_surface_mesh(mesh);
-      std::vector<std::pair<cgal::SurfaceMesh::Face_index, cgal::SurfaceMesh::Face_index>> pairs;
-      PMP::self_intersections(sm, std::back_inserter(pairs));
-      d.self_intersections = static_cast<int>(pairs.size());
+      d.self_intersections = static_cast<int>(self_intersecting_faces(mesh).size());
     }
   }
 

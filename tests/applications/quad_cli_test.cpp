@@ -2,6 +2,7 @@
 // agrees with it, with the map built in memory and read back from a map directory; clean exit
 // codes for bad command lines, inputs and outputs.
 #include "applications/quad/quad_mesh.h"
+#include "applications/quad/surface_projector.h"
 
 #include "formats/mesh_io.h"
 #include "polycube/polycube_build.h"
@@ -380,6 +381,42 @@ TEST(QuadCli, CoarseModelIsSplitBeforeTheMap) {
   EXPECT_LT(split["quality"]["hausdorff_percent_diagonal"].get<double>(), whole["quality"]["hausdorff_percent_diagonal"].get<double>());
   // The measure is against the model as read: the same diagonal either way.
   EXPECT_DOUBLE_EQ(split["quality"]["diagonal"].get<double>(), whole["quality"]["diagonal"].get<double>());
+}
+
+// A model whose surface passes through itself (CGAL's elk.off, 7 face pairs). Its own
+// orientations give polycubes, so by default (--separate auto) the quads are made on it. With
+// --separate always the map and the quads are made on its separated copy, and the quads go back
+// to the model itself: every vertex on the elk's own surface (the copy is up to a percent of the
+// diagonal away), closed, genus 1, nothing flipped, within the bound.
+TEST(QuadCli, QuadsOfASelfIntersectingModelLieOnTheModel) {
+  const std::string dir = test::temp_dir("quad-separated");
+  const std::string out = dir + "/elk.obj", report_path = dir + "/elk.json";
+  const test::CliRun run = polycube_cli("quad " + quoted(test::data_path("elk.off")) + " --separate always -o " + quoted(out) +
+                                        " --report " + quoted(report_path));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("separate: the quads moved back to the model"), std::string::npos) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
+  ASSERT_GT(report["input"]["self_intersections"].get<int>(), 0) << "elk.off no longer intersects itself: pick another mesh";
+  EXPECT_EQ(report["separation"]["pairs_before"].get<int>(), report["input"]["self_intersections"].get<int>());
+  EXPECT_GT(report["separation"]["max_shift"].get<double>(), 1e-4);
+  const QuadMesh quads = read_quads(out);
+  const QuadTopology t = quad_topology(quads);
+  EXPECT_TRUE(t.closed_manifold());
+  EXPECT_EQ(t.genus(), 1);
+  EXPECT_EQ(report["quality"]["flipped_quads"].get<int>(), 0);
+  EXPECT_LT(report["quality"]["hausdorff_percent_diagonal"].get<double>(), 0.5);
+  const TriMesh elk = test::load_test_mesh("elk.off");
+  const SurfaceProjector surface(elk);
+  const double diagonal = bounding_box(elk.V).diagonal();
+  double farthest = 0;
+  for (int v = 0; v < quads.num_vertices(); ++v) farthest = std::max(farthest, surface.closest(quads.V.row(v).transpose()).distance);
+  EXPECT_LT(farthest, 1e-9 * diagonal);
+
+  const std::string own_report = dir + "/own.json";
+  const test::CliRun own = polycube_cli("quad --quiet " + quoted(test::data_path("elk.off")) + " -o " + quoted(dir + "/own.obj") +
+                                        " --report " + quoted(own_report));
+  ASSERT_EQ(own.code, 0) << own.err;
+  EXPECT_FALSE(nlohmann::json::parse(test::read_file(own_report)).contains("separation"));
 }
 
 TEST(QuadCli, CleanErrors) {
