@@ -698,9 +698,28 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     written_polycube = finished.polycube;
     const Polycube& P = *written_polycube;
     on_polycube_xyz = finished.on_polycube_xyz;
-    write_mesh(polycube_path, mesh_to_input(P.mesh));
+    // The files as written, in the input frame, audited there: the rotation's rounding can decide
+    // a near tie on an edge of P the other way (elk: a model triangle 0 flipped in the turned
+    // frame, 1 in the input's), so the report gives the files' figures, and what audits flipped
+    // there only is untangled there.
+    Polycube P_input = P;
+    P_input.mesh = mesh_to_input(P.mesh);
+    Finished written;
+    written.polycube = &P_input;
+    written.on_model_xyz = to_input(finished.on_model_xyz);
+    written.on_polycube_xyz = to_input(finished.on_polycube_xyz);
+    written.audit = rotation.isIdentity(0) ? finished.audit
+                                           : audit_map(prepared.mesh, P_input.mesh, written.on_model_xyz, written.on_polycube_xyz);
+    if (written.bad_p() > finished.bad_p() || written.bad_m() > finished.bad_m()) {
+      progress.stage("audit", "the files in the input frame: " + std::to_string(written.bad_p()) + " / " + std::to_string(written.bad_m()) +
+                                  " flipped or degenerate image triangles, against " + std::to_string(finished.bad_p()) + " / " +
+                                  std::to_string(finished.bad_m()) + " in the turned frame");
+      untangle_images(prepared.mesh, written, options.untangle_shift, options.untangle_shift_max, progress);
+      report["written"] = {{"untangling", written.untangling}};
+    }
+    write_mesh(polycube_path, P_input.mesh);
     outputs.push_back(polycube_path);
-    const MapAudit& audit = finished.audit;
+    const MapAudit& audit = written.audit;
     report["map"] = {{"contours", map->contours},
                      {"pieces", map->pieces.size()},
                      {"slits", slits},
@@ -725,12 +744,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                      {"untangling", finished.untangling},
                      {"exact", finished.overlay}};
     TriMesh on_model = P.mesh;
-    on_model.V = to_input(finished.on_model_xyz);
+    on_model.V = written.on_model_xyz;
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
     write_mesh(on_model_path, on_model);
     outputs.push_back(on_model_path);
     TriMesh on_polycube = prepared.mesh;
-    on_polycube.V = to_input(on_polycube_xyz);
+    on_polycube.V = written.on_polycube_xyz;
     const std::string on_polycube_path = (dir / "model_on_polycube.obj").string();
     write_mesh(on_polycube_path, on_polycube);
     outputs.push_back(on_polycube_path);
@@ -738,8 +757,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
                               std::to_string(audit.model_to_polycube.flipped) + " flipped image triangles (P to M / M to P), eps_angle " +
                               std::to_string(audit.distortion.eps_angle));
     // The best map found is written either way; what it misses is said, and in the report.
-    report["map"]["meets_contract"] = finished.meets_contract();
-    if (!finished.meets_contract()) progress.warning("the map falls short of its contract: " + finished.shortfall());
+    report["map"]["meets_contract"] = written.meets_contract();
+    if (!written.meets_contract()) progress.warning("the map falls short of its contract: " + written.shortfall());
   }
 
   const std::string pieces_path = (dir / "pieces.ply").string();
