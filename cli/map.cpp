@@ -469,14 +469,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   report["parameters"]["untangle_shift_max"] = options.untangle_shift_max;
   report["parameters"]["finer_contours"] = options.finer_contours;
   std::vector<std::string> outputs;
-  // Self-intersecting: every stage runs on the separated copy; the images on it go back to the
-  // model at the end, and the audit is made again there.
-  Separation separation;
-  if (options.separate == "always")
-    separation = separated_for_stages(prepared, progress, report);
-  else
-    separation.mesh = prepared.mesh;
-  const TriMesh& source = separation.mesh;
+  // Self-intersecting: every stage runs on the separated copy; P's images on it go back to the
+  // model at the end, where the files are audited (below).
+  const std::optional<Separation> separation =
+      options.separate == "always" ? separated_for_stages(prepared, progress, report) : std::nullopt;
+  const TriMesh& source = separation ? separation->mesh : prepared.mesh;
 
   // The pipeline runs on the model turned into the chosen frame; outputs go back to the input's.
   // One pass: the orientation search (with --align auto) and the finished maps of its candidates
@@ -588,28 +585,14 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (kept->finished->meets_contract()) break;
     }
   }
-  if (separation.rounds > 0 && kept->finished) {
-    // P's images on the copy, moved to the same faces and barycentric coordinates of the model,
-    // and audited there (the audit on the copy goes to the report).
+  if (separation && kept->finished) {
+    // P's images on the copy, moved to the same faces and barycentric coordinates of the model;
+    // the audit on the copy goes to the report, the files' audit on the model is made below.
     Finished& finished = *kept->finished;
     report["separation"]["on_copy"] = {{"polycube_to_model", direction_json(finished.audit.polycube_to_model)},
                                        {"model_to_polycube", direction_json(finished.audit.model_to_polycube)},
                                        {"eps_angle", finished.audit.distortion.eps_angle}};
-    const TriMesh turned = rotated(prepared.mesh, kept->rotation);
-    finished.on_model_xyz = to_original_surface(kept->model, turned, finished.on_model_xyz);
-    finished.audit = audit_map(turned, finished.polycube->mesh, finished.on_model_xyz, finished.on_polycube_xyz);
-    progress.stage("separate", "P's images moved back to the model: " + std::to_string(finished.bad_p()) + " / " +
-                                   std::to_string(finished.bad_m()) + " flipped or degenerate image triangles (P to M / M to P)");
-    // Where the model's own sheets pass near each other, an image triangle can turn against the
-    // surface under it: the same untangling as the finished map's, on the model.
-    const nlohmann::json untangling_on_copy = finished.untangling;
-    const double untangle_seconds_on_copy = finished.untangle_seconds;
-    untangle_images(turned, finished, options.untangle_shift, options.untangle_shift_max, progress);
-    if (finished.untangle_seconds != untangle_seconds_on_copy) {
-      report["separation"]["untangling"] = finished.untangling;
-      finished.untangling = untangling_on_copy;
-      finished.untangle_seconds += untangle_seconds_on_copy;
-    }
+    finished.on_model_xyz = to_original_surface(kept->model, rotated(prepared.mesh, kept->rotation), finished.on_model_xyz);
   }
   const Attempt& chosen = *kept;
   const Eigen::Matrix3d rotation = chosen.rotation;
@@ -698,22 +681,24 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     written_polycube = finished.polycube;
     const Polycube& P = *written_polycube;
     on_polycube_xyz = finished.on_polycube_xyz;
-    // The files as written, in the input frame, audited there: the rotation's rounding can decide
-    // a near tie on an edge of P the other way (elk: a model triangle 0 flipped in the turned
-    // frame, 1 in the input's), so the report gives the files' figures, and what audits flipped
-    // there only is untangled there.
+    // The files as written, in the input frame and on the model, audited there: the rotation's
+    // rounding can decide a near tie on an edge of P the other way (elk: a model triangle 0
+    // flipped in the turned frame, 1 in the input's), and images moved back from a separated
+    // copy can turn against the model where its sheets pass near each other (man: 122 of P's
+    // triangles). The report gives the files' figures; what flips only there is untangled there.
     Polycube P_input = P;
     P_input.mesh = mesh_to_input(P.mesh);
     Finished written;
     written.polycube = &P_input;
     written.on_model_xyz = to_input(finished.on_model_xyz);
     written.on_polycube_xyz = to_input(finished.on_polycube_xyz);
-    written.audit = rotation.isIdentity(0) ? finished.audit
-                                           : audit_map(prepared.mesh, P_input.mesh, written.on_model_xyz, written.on_polycube_xyz);
+    written.audit = rotation.isIdentity(0) && !separation
+                        ? finished.audit
+                        : audit_map(prepared.mesh, P_input.mesh, written.on_model_xyz, written.on_polycube_xyz);
     if (written.bad_p() > finished.bad_p() || written.bad_m() > finished.bad_m()) {
-      progress.stage("audit", "the files in the input frame: " + std::to_string(written.bad_p()) + " / " + std::to_string(written.bad_m()) +
+      progress.stage("audit", "the files as written: " + std::to_string(written.bad_p()) + " / " + std::to_string(written.bad_m()) +
                                   " flipped or degenerate image triangles, against " + std::to_string(finished.bad_p()) + " / " +
-                                  std::to_string(finished.bad_m()) + " in the turned frame");
+                                  std::to_string(finished.bad_m()) + (separation ? " on the separated copy" : " in the turned frame"));
       untangle_images(prepared.mesh, written, options.untangle_shift, options.untangle_shift_max, progress);
       report["written"] = {{"untangling", written.untangling}};
     }

@@ -24,12 +24,8 @@ PreparedMesh load_mesh(const MeshInput& input, const Progress& progress) {
   return prepared;
 }
 
-Separation separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report) {
-  if (prepared.diagnosis.self_intersections <= 0) {
-    Separation none;
-    none.mesh = prepared.mesh;
-    return none;
-  }
+std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report) {
+  if (prepared.diagnosis.self_intersections <= 0) return std::nullopt;
   progress.stage("separate", "the model intersects itself: smoothing round the crossings, on a copy the planes cut");
   Separation s = separate_self_intersections(prepared.mesh);
   progress.stage("separate", std::to_string(s.pairs_before) + " face pairs apart after " + std::to_string(s.rounds) + " rounds; " +

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 
 namespace polycube::cli {
@@ -22,10 +23,10 @@ void add_mesh_input_options(CLI::App& command, MeshInput& input);
 // Reads and prepares the mesh; reports each repair as a warning. Throws InputError.
 PreparedMesh load_mesh(const MeshInput& input, const Progress& progress);
 
-// The mesh the stages cut by planes run on: the model itself, or, when it intersects itself,
-// its separated copy (separate.h; same vertices and faces), said on stderr and in `report`
-// ("separation"). Results on the copy go back to the model with to_original_surface.
-Separation separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report);
+// When the model intersects itself: its separated copy (separate.h; same vertices and faces) for
+// the stages that cut it by planes, said on stderr and in `report` ("separation"); nothing
+// otherwise. Results on the copy go back to the model with to_original_surface.
+std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report);
 
 // The diagnosis as a JSON object (keys documented in README.md).
 nlohmann::json diagnosis_json(const PreparedMesh& prepared);

@@ -254,21 +254,21 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // A self-intersecting model none of whose orientations gives a polycube (a cutting plane's
   // contours cross): the search again on its separated copy (separate.h; made when first needed,
   // split as the model is), the quads moved back to the model at the end.
-  Separation separation;
+  std::optional<Separation> separation;
   SplitLongEdges separated_split;
   QuadModel separated_as_read, separated_split_copy;
   const auto separated_of = [&](const QuadModel& on) -> const QuadModel* {
     if (prepared.diagnosis.self_intersections <= 0 || on.separation || options.separate == "never") return nullptr;
     if (!separated_as_read.mesh) {
       separation = separated_for_stages(prepared, progress, report);
-      separated_as_read.mesh = &separation.mesh;
-      separated_as_read.separation = &separation;
+      separated_as_read.mesh = &separation->mesh;
+      separated_as_read.separation = &*separation;
       if (split.rounds > 0) {
-        separated_split = split_long_edges(separation.mesh, options.split_edges * split_cell(separation.mesh), kSplitEdgesMaxFaces);
+        separated_split = split_long_edges(separation->mesh, options.split_edges * split_cell(separation->mesh), kSplitEdgesMaxFaces);
         separated_split_copy.mesh = &separated_split.mesh;
-        separated_split_copy.sampled = &separation.mesh;
+        separated_split_copy.sampled = &separation->mesh;
         separated_split_copy.split = true;
-        separated_split_copy.separation = &separation;
+        separated_split_copy.separation = &*separation;
       }
     }
     return on.split ? &separated_split_copy : &separated_as_read;
