@@ -49,7 +49,7 @@ struct QuadCommandOptions {
   std::string report_path;
   std::string preview_path;
   std::string align = "auto";
-  std::string separate = "auto";
+  std::string separate = "never";
   int smooth_map_sweeps = 0;
   // Quads that still fall short are tried once more with d_a divided by this (as `map` does; a
   // try with more than refine_bound_growth × target_faces quads is not kept then); 1: never.
@@ -713,9 +713,10 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "corners", "none"}));
   command->add_option("--separate", options->separate,
-                      "A model that intersects itself (not with --map): auto: when none of its orientations gives a polycube, search "
-                      "again on a copy pulled apart round the crossings (local smoothing), the quads moved back onto the model at the "
-                      "end; always: make the map and the quads on that copy from the start; never: the model only")
+                      "A model that intersects itself (not with --map): never: the model only; auto: when none of its orientations "
+                      "gives a polycube, search again on a copy pulled apart round the crossings (local smoothing), the quads moved "
+                      "back onto the model at the end (ranked against the other tries as measured on the copy); always: the first "
+                      "search on that copy")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "always", "never"}));
   command->add_option("--dz", options->topology.dz, "Largest gap between cutting planes, unit-cube units (paper's d_z; not with --map)")

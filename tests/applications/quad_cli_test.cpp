@@ -383,8 +383,8 @@ TEST(QuadCli, CoarseModelIsSplitBeforeTheMap) {
   EXPECT_DOUBLE_EQ(split["quality"]["diagonal"].get<double>(), whole["quality"]["diagonal"].get<double>());
 }
 
-// A model whose surface passes through itself (CGAL's elk.off, 7 face pairs). Its own
-// orientations give polycubes, so by default (--separate auto) the quads are made on it. With
+// A model whose surface passes through itself (CGAL's elk.off, 7 face pairs). By default
+// (--separate never) the quads are made on it. With
 // --separate always the map and the quads are made on its separated copy, and the quads go back
 // to the model itself: every vertex on the elk's own surface (the copy is up to a percent of the
 // diagonal away), closed, genus 1, nothing flipped, within the bound.
