@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -49,7 +50,7 @@ struct QuadCommandOptions {
   std::string report_path;
   std::string preview_path;
   std::string align = "auto";
-  std::string separate = "never";
+  std::string separate = "auto";
   int smooth_map_sweeps = 0;
   // Quads that still fall short are tried once more with d_a divided by this (as `map` does; a
   // try with more than refine_bound_growth × target_faces quads is not kept then); 1: never.
@@ -178,6 +179,14 @@ struct QuadModel {
   const TriMesh* sampled = nullptr;  // the model as read, when mesh is its split copy
   bool split = false;
   const Separation* separation = nullptr;  // mesh is this separated copy (or its split copy)
+  // A separated copy's map places its quads on the model itself (the same faces): this is the
+  // model's search model (as read or split as the copy is); the quads are relaxed, fitted, refined
+  // and measured there, so its tries rank against the model's own. Null: on this one.
+  const QuadModel* quads_on = nullptr;
+  const QuadModel& placement() const { return quads_on ? *quads_on : *this; }
+  // No orientation of it gave a polycube (--separate auto then searches its copy; so do the later
+  // searches, at once).
+  mutable bool no_polycube = false;
   // Built on first use: the model as read's is needed only when a search runs on it (or --map).
   std::shared_ptr<const SurfaceProjector> projector() const {
     if (!projector_)
@@ -263,12 +272,14 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       separation = separated_for_stages(prepared, progress, report);
       separated_as_read.mesh = &separation->mesh;
       separated_as_read.separation = &*separation;
+      separated_as_read.quads_on = &as_read;
       if (split.rounds > 0) {
         separated_split = split_long_edges(separation->mesh, options.split_edges * split_cell(separation->mesh), kSplitEdgesMaxFaces);
         separated_split_copy.mesh = &separated_split.mesh;
         separated_split_copy.sampled = &separation->mesh;
         separated_split_copy.split = true;
         separated_split_copy.separation = &*separation;
+        separated_split_copy.quads_on = &split_copy;
       }
     }
     return on.split ? &separated_split_copy : &separated_as_read;
@@ -336,6 +347,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                                 const QuadModel& given) {
     const QuadModel* on = &given;
     const TriMesh& model = *given.mesh;
+    if (given.separation) suffix += ", separated copy";
     Alignment alignment;
     if (options.align == "auto" || options.align == "corners") {
       AlignmentOptions align_options;
@@ -346,6 +358,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       const double align_start = progress.elapsed_seconds();
       alignment = choose_alignment(model, options.topology, polycube, align_options);
       if (alignment.chosen < 0) {
+        on->no_polycube = true;
         if (const QuadModel* copy = separated_of(*on)) {
           progress.stage("align", "no orientation gives a valid polycube: the search again on the model's separated copy");
           on = copy;
@@ -376,13 +389,26 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   };
   if (options.map_dir.empty()) {
     const QuadModel* copy = options.separate == "always" ? separated_of(split_model) : nullptr;
-    add_attempts(options.polycube, report["alignment"], copy ? ", separated copy" : "", copy ? *copy : split_model);
+    add_attempts(options.polycube, report["alignment"], "", copy ? *copy : split_model);
   }
   // The map stages one orientation still needs, then its quads.
   const auto remesh_with = [&](QuadAttempt& a) {
     const double start = progress.elapsed_seconds();
     a.aligned = rotated(*a.on->mesh, a.rotation);
-    const std::shared_ptr<const SurfaceProjector> projector = a.on->projector();
+    const std::shared_ptr<const SurfaceProjector> projector = a.on->placement().projector();
+    // A point of the map's mesh (input frame) at its place on the model the quads go on: itself,
+    // or for a separated copy the same face and barycentric coordinates of the model (through
+    // the copy as read's closest point when the copy is split: its faces are not the model's).
+    std::function<Eigen::Vector3d(const Eigen::Vector3d&)> to_placement;
+    if (a.on->separation) {
+      progress.stage("separate", "the quads carried by the separated copy's map onto the model itself (same faces), and placed, fitted and measured there");
+      const std::shared_ptr<const SurfaceProjector> copy = separated_as_read.projector();
+      const TriMesh& model = prepared.mesh;
+      to_placement = [copy, &model](const Eigen::Vector3d& x) {
+        const SurfaceHit hit = copy->closest(x);
+        return to_original_point(copy->surface(), model, hit.face, hit.point);
+      };
+    }
     progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
     if (!a.topology) a.topology = std::make_shared<TopologyResult>(analyse_topology(a.aligned, options.topology));
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
@@ -402,14 +428,27 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       smooth_options.sweeps = options.smooth_map_sweeps;
       const MapSmoothingResult smoothed = smooth_map(a.aligned, a.polycube->polycube, *a.map, smooth_options);
       a.smooth_map_seconds = smoothed.seconds;
-      to_model = projected_map(vertex_image_map(P, smoothed.polycube_on_model_xyz * a.rotation), projector);
+      Eigen::MatrixX3d images = smoothed.polycube_on_model_xyz * a.rotation;
+      if (to_placement)
+        for (int v = 0; v < images.rows(); ++v) images.row(v) = to_placement(images.row(v).transpose()).transpose();
+      to_model = projected_map(vertex_image_map(P, images), projector);
     } else {
       const TriMesh& aligned = a.aligned;
       const PolycubeMap& map = *a.map;
       const Eigen::Matrix3d rotation = a.rotation;
-      to_model = [&aligned, &map, rotation](const SurfacePoint& p) -> Eigen::Vector3d {
-        return rotation.transpose() * surface_position(aligned, map.to_model(p));
-      };
+      if (a.on->separation && !a.on->split) {
+        // The copy as read has the model's faces: the map's surface points are the model's.
+        const TriMesh& model = prepared.mesh;
+        to_model = [&model, &map](const SurfacePoint& p) -> Eigen::Vector3d { return surface_position(model, map.to_model(p)); };
+      } else if (to_placement) {
+        to_model = [&aligned, &map, rotation, to_placement](const SurfacePoint& p) -> Eigen::Vector3d {
+          return to_placement(rotation.transpose() * surface_position(aligned, map.to_model(p)));
+        };
+      } else {
+        to_model = [&aligned, &map, rotation](const SurfacePoint& p) -> Eigen::Vector3d {
+          return rotation.transpose() * surface_position(aligned, map.to_model(p));
+        };
+      }
     }
     QuadRemeshOptions try_options = remesh;
     if (a.max_quads > 0) try_options.grid.max_quads = a.max_quads;
@@ -470,13 +509,21 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // split model's orientation search can settle on a polycube with many more corners than the
   // model as read (couplingdown on one machine: 2 294 corners, 45 008 quads for 10 000 and 14.2°;
   // as read 704 corners, 18 453 quads, 7.8°); a capped try, kept only if as good and not as many.
+  // The model a later search runs on: the separated copy (as read or split) with --separate
+  // always, or with auto once a search on that model found no orientation with a polycube (man.off:
+  // its model as read failed again in every orientation before each later search fell back,
+  // 350 s each); else the model.
+  const auto searched = [&](const QuadModel& on) -> const QuadModel& {
+    const QuadModel* copy = options.separate == "always" || on.no_polycube ? separated_of(on) : nullptr;
+    return copy ? *copy : on;
+  };
   if ((kept->worth_retrying() || kept->more_than(most_quads)) && options.map_dir.empty() && split_model.split)
-    search_again(options.polycube, "model_as_read", ", model as read", "on the model as read (long edges not split)", as_read);
+    search_again(options.polycube, "model_as_read", ", model as read", "on the model as read (long edges not split)", searched(as_read));
   // The later searches run on the model as read, then on the split model: so every search made
   // before the split still runs when the quads fall short (cow's best, 2.49 % and no flipped quad,
   // came from the model as read with finer contours; its split model's searches kept 7 flipped).
-  std::vector<const QuadModel*> models = {&as_read};
-  if (split_model.split) models.push_back(&split_model);
+  std::vector<const QuadModel*> models = {&searched(as_read)};
+  if (split_model.split) models.push_back(&searched(split_model));
   const auto model_key = [&](const std::string& key, const QuadModel& on) { return on.split ? key + "_split" : key; };
   const auto model_suffix = [&](const QuadModel& on) { return on.split || !split_model.split ? "" : ", model as read"; };
   // Still short: once more with finer contours, as `map` does (a thin part that d_a drops from P
@@ -504,14 +551,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     // The kept try's corners mended (the other tries are only compared).
     QuadRemeshOptions mend = remesh;
     mend.mend_corners = true;
-    const QuadModel* on = kept->on;
-    if (on->separation) {
-      kept->result->mesh.V = to_original_surface(on->separation->mesh, prepared.mesh, kept->result->mesh.V);
-      kept->result->quality = QuadQuality{};  // measured again on the model
-      progress.stage("separate", "the quads moved back to the model from its separated copy");
-      on = on->split ? &split_copy : &as_read;
-    }
-    mend_quad_corners(*kept->result, *on->projector(), mend, report_stage);
+    mend_quad_corners(*kept->result, *kept->on->placement().projector(), mend, report_stage);
   }
   if (std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->result.has_value(); }) > 1) {
     double retry_seconds = 0;
@@ -632,7 +672,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     report["quality"] = quality_json(q);
     // Where the flipped and degenerate quads are (the first 20), to find them in a viewer.
     nlohmann::json bad = nlohmann::json::array();
-    for (int b : bad_quads(result.mesh, *kept->on->projector(), remesh.quality)) {
+    for (int b : bad_quads(result.mesh, *kept->on->placement().projector(), remesh.quality)) {
       if (bad.size() == 20) break;
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
       for (int k = 0; k < 4; ++k) centre += result.mesh.V.row(result.mesh.Q(b, k)).transpose() / 4;
@@ -714,9 +754,9 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
       ->check(CLI::IsMember({"auto", "corners", "none"}));
   command->add_option("--separate", options->separate,
                       "A model that intersects itself (not with --map): never: the model only; auto: when none of its orientations "
-                      "gives a polycube, search again on a copy pulled apart round the crossings (local smoothing), the quads moved "
-                      "back onto the model at the end (ranked against the other tries as measured on the copy); always: the first "
-                      "search on that copy")
+                      "gives a polycube, that search and the later ones on that model run on a copy pulled apart round the crossings "
+                      "(local smoothing); always: every search on that copy. The copy's map carries the quads onto the model itself, "
+                      "where they are relaxed, fitted, refined and measured like any other try")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "always", "never"}));
   command->add_option("--dz", options->topology.dz, "Largest gap between cutting planes, unit-cube units (paper's d_z; not with --map)")

@@ -139,13 +139,15 @@ Eigen::MatrixX3d to_original_surface(const TriMesh& copy, const TriMesh& origina
   Eigen::MatrixX3d out(points.rows(), 3);
   for (int i = 0; i < points.rows(); ++i) {
     const auto [closest, id] = tree.closest_point_and_primitive(Point(points(i, 0), points(i, 1), points(i, 2)));
-    const int f = static_cast<int>(id - triangles.begin());
-    const Eigen::Vector3d x(closest.x(), closest.y(), closest.z());
-    const Eigen::Vector3d bary = clamp_bary(barycentric3(copy.V.row(copy.F(f, 0)), copy.V.row(copy.F(f, 1)), copy.V.row(copy.F(f, 2)), x));
-    out.row(i) = bary[0] * original.V.row(original.F(f, 0)) + bary[1] * original.V.row(original.F(f, 1)) +
-                 bary[2] * original.V.row(original.F(f, 2));
+    out.row(i) = to_original_point(copy, original, static_cast<int>(id - triangles.begin()), Eigen::Vector3d(closest.x(), closest.y(), closest.z()));
   }
   return out;
+}
+
+Eigen::Vector3d to_original_point(const TriMesh& copy, const TriMesh& original, int f, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d bary = clamp_bary(barycentric3(copy.V.row(copy.F(f, 0)), copy.V.row(copy.F(f, 1)), copy.V.row(copy.F(f, 2)), x));
+  return bary[0] * original.V.row(original.F(f, 0)).transpose() + bary[1] * original.V.row(original.F(f, 1)).transpose() +
+         bary[2] * original.V.row(original.F(f, 2)).transpose();
 }
 
 }  // namespace polycube

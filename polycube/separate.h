@@ -57,4 +57,9 @@ Separation separate_self_intersections(const TriMesh& model, const SeparationOpt
 // barycentric coordinates there, evaluated on the original's face.
 Eigen::MatrixX3d to_original_surface(const TriMesh& copy, const TriMesh& original, const Eigen::MatrixX3d& points);
 
+// One point x of the copy's face f (up to rounding) at the same place of the original: f's
+// barycentric coordinates of x (clamped to the face) evaluated on the original's face f. The two
+// meshes must have the same faces (not checked here).
+Eigen::Vector3d to_original_point(const TriMesh& copy, const TriMesh& original, int f, const Eigen::Vector3d& x);
+
 }  // namespace polycube
