@@ -384,34 +384,41 @@ TEST(QuadCli, CoarseModelIsSplitBeforeTheMap) {
 }
 
 // A model whose surface passes through itself (CGAL's elk.off, 7 face pairs). By default
-// (--separate never) the quads are made on it. With
-// --separate always the map and the quads are made on its separated copy, and the quads go back
-// to the model itself: every vertex on the elk's own surface (the copy is up to a percent of the
-// diagonal away), closed, genus 1, nothing flipped, within the bound.
+// (--separate auto; elk's own orientations give a polycube) the quads are made on it. With
+// --separate always the map is built on its separated copy and carries the quads onto the model
+// itself, where they are relaxed, fitted and measured: every vertex on the elk's own surface (the
+// copy is up to a percent of the diagonal away), closed, genus 1, nothing flipped, within the
+// bound. Both ways the copy's map reaches the model: the copy as read (the model's faces) and its
+// long edges split (other faces: through the copy's closest point).
 TEST(QuadCli, QuadsOfASelfIntersectingModelLieOnTheModel) {
   const std::string dir = test::temp_dir("quad-separated");
-  const std::string out = dir + "/elk.obj", report_path = dir + "/elk.json";
-  const test::CliRun run = polycube_cli("quad " + quoted(test::data_path("elk.off")) + " --separate always -o " + quoted(out) +
-                                        " --report " + quoted(report_path));
-  ASSERT_EQ(run.code, 0) << run.err;
-  EXPECT_NE(run.err.find("separate: the quads carried by the separated copy's map onto the model itself"), std::string::npos) << run.err;
-  const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
-  ASSERT_GT(report["input"]["self_intersections"].get<int>(), 0) << "elk.off no longer intersects itself: pick another mesh";
-  EXPECT_NE(report["alignment"]["chosen"].get<std::string>().find("separated copy"), std::string::npos) << report["alignment"];
-  EXPECT_EQ(report["separation"]["pairs_before"].get<int>(), report["input"]["self_intersections"].get<int>());
-  EXPECT_GT(report["separation"]["max_shift"].get<double>(), 1e-4);
-  const QuadMesh quads = read_quads(out);
-  const QuadTopology t = quad_topology(quads);
-  EXPECT_TRUE(t.closed_manifold());
-  EXPECT_EQ(t.genus(), 1);
-  EXPECT_EQ(report["quality"]["flipped_quads"].get<int>(), 0);
-  EXPECT_LT(report["quality"]["hausdorff_percent_diagonal"].get<double>(), 0.5);
   const TriMesh elk = test::load_test_mesh("elk.off");
   const SurfaceProjector surface(elk);
   const double diagonal = bounding_box(elk.V).diagonal();
-  double farthest = 0;
-  for (int v = 0; v < quads.num_vertices(); ++v) farthest = std::max(farthest, surface.closest(quads.V.row(v).transpose()).distance);
-  EXPECT_LT(farthest, 1e-9 * diagonal);
+  for (const std::string extra : {"", " --split-edges 0"}) {
+    SCOPED_TRACE("options:" + extra);
+    const std::string out = dir + "/elk.obj", report_path = dir + "/elk.json";
+    const test::CliRun run = polycube_cli("quad " + quoted(test::data_path("elk.off")) + " --separate always" + extra + " -o " +
+                                          quoted(out) + " --report " + quoted(report_path));
+    ASSERT_EQ(run.code, 0) << run.err;
+    EXPECT_NE(run.err.find("separate: the quads carried by the separated copy's map onto the model itself"), std::string::npos)
+        << run.err;
+    const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
+    ASSERT_GT(report["input"]["self_intersections"].get<int>(), 0) << "elk.off no longer intersects itself: pick another mesh";
+    EXPECT_NE(report["alignment"]["chosen"].get<std::string>().find("separated copy"), std::string::npos) << report["alignment"];
+    EXPECT_EQ(report["split"]["kept"].get<bool>(), extra.empty());
+    EXPECT_EQ(report["separation"]["pairs_before"].get<int>(), report["input"]["self_intersections"].get<int>());
+    EXPECT_GT(report["separation"]["max_shift"].get<double>(), 1e-4);
+    const QuadMesh quads = read_quads(out);
+    const QuadTopology t = quad_topology(quads);
+    EXPECT_TRUE(t.closed_manifold());
+    EXPECT_EQ(t.genus(), 1);
+    EXPECT_EQ(report["quality"]["flipped_quads"].get<int>(), 0);
+    EXPECT_LT(report["quality"]["hausdorff_percent_diagonal"].get<double>(), 0.5);
+    double farthest = 0;
+    for (int v = 0; v < quads.num_vertices(); ++v) farthest = std::max(farthest, surface.closest(quads.V.row(v).transpose()).distance);
+    EXPECT_LT(farthest, 1e-9 * diagonal);
+  }
 
   const std::string own_report = dir + "/own.json";
   const test::CliRun own = polycube_cli("quad --quiet " + quoted(test::data_path("elk.off")) + " -o " + quoted(dir + "/own.obj") +
