@@ -392,6 +392,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     add_attempts(options.polycube, report["alignment"], "", copy ? *copy : split_model);
   }
   // The map stages one orientation still needs, then its quads.
+  bool placement_said = false;  // the copy's placement said once
   const auto remesh_with = [&](QuadAttempt& a) {
     const double start = progress.elapsed_seconds();
     a.aligned = rotated(*a.on->mesh, a.rotation);
@@ -401,7 +402,9 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     // the copy as read's closest point when the copy is split: its faces are not the model's).
     std::function<Eigen::Vector3d(const Eigen::Vector3d&)> to_placement;
     if (a.on->separation) {
-      progress.stage("separate", "the quads carried by the separated copy's map onto the model itself (same faces), and placed, fitted and measured there");
+      if (!placement_said)
+        progress.stage("separate", "the quads carried by the separated copy's map onto the model itself (same faces), and placed, fitted and measured there");
+      placement_said = true;
       const std::shared_ptr<const SurfaceProjector> copy = separated_as_read.projector();
       const TriMesh& model = prepared.mesh;
       to_placement = [copy, &model](const Eigen::Vector3d& x) {
