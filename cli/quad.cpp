@@ -505,13 +505,6 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       progress.warning(key + ": " + e.what());
     }
   };
-  // Still short, on the split model: the whole search again on the model as read. The split is
-  // what CAD models need, but on coarse organic ones whose quads fall short (thin parts, folds) it
-  // was no better and sometimes worse (femur's quads on the split model: 31 flipped and 2.42 %; on
-  // the model as read 1 and 1.37 %). Also when the quads are fine but far more than asked: the
-  // split model's orientation search can settle on a polycube with many more corners than the
-  // model as read (couplingdown on one machine: 2 294 corners, 45 008 quads for 10 000 and 14.2°;
-  // as read 704 corners, 18 453 quads, 7.8°); a capped try, kept only if as good and not as many.
   // The model a later search runs on: the separated copy (as read or split) with --separate
   // always, or with auto once a search on that model found no orientation with a polycube (man.off:
   // its model as read failed again in every orientation before each later search fell back,
@@ -520,6 +513,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     const QuadModel* copy = options.separate == "always" || on.no_polycube ? separated_of(on) : nullptr;
     return copy ? *copy : on;
   };
+  // Still short, on the split model: the whole search again on the model as read. The split is
+  // what CAD models need, but on coarse organic ones whose quads fall short (thin parts, folds) it
+  // was no better and sometimes worse (femur's quads on the split model: 31 flipped and 2.42 %; on
+  // the model as read 1 and 1.37 %). Also when the quads are fine but far more than asked: the
+  // split model's orientation search can settle on a polycube with many more corners than the
+  // model as read (couplingdown on one machine: 2 294 corners, 45 008 quads for 10 000 and 14.2°;
+  // as read 704 corners, 18 453 quads, 7.8°); a capped try, kept only if as good and not as many.
   if ((kept->worth_retrying() || kept->more_than(most_quads)) && options.map_dir.empty() && split_model.split)
     search_again(options.polycube, "model_as_read", ", model as read", "on the model as read (long edges not split)", searched(as_read));
   // The later searches run on the model as read, then on the split model: so every search made
