@@ -443,13 +443,10 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
         // The copy as read has the model's faces: the map's surface points are the model's.
         const TriMesh& model = prepared.mesh;
         to_model = [&model, &map](const SurfacePoint& p) -> Eigen::Vector3d { return surface_position(model, map.to_model(p)); };
-      } else if (to_placement) {
-        to_model = [&aligned, &map, rotation, to_placement](const SurfacePoint& p) -> Eigen::Vector3d {
-          return to_placement(rotation.transpose() * surface_position(aligned, map.to_model(p)));
-        };
       } else {
-        to_model = [&aligned, &map, rotation](const SurfacePoint& p) -> Eigen::Vector3d {
-          return rotation.transpose() * surface_position(aligned, map.to_model(p));
+        to_model = [&aligned, &map, rotation, to_placement](const SurfacePoint& p) -> Eigen::Vector3d {
+          const Eigen::Vector3d x = rotation.transpose() * surface_position(aligned, map.to_model(p));
+          return to_placement ? to_placement(x) : x;
         };
       }
     }
