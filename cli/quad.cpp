@@ -661,7 +661,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     report["untangling"] = {{"flipped_before", result.untangling.flipped_before},
                             {"flipped_after", result.untangling.flipped_after},
                             {"moves", result.untangling.moves},
-                            {"patches", result.untangling.patches}};
+                            {"patches", result.untangling.patches},
+                            {"collapsed_quads", result.collapsed_quads}};
     if (result.inverted_before_mending >= 0)
       report["corners_mended"] = {{"inverted_before", result.inverted_before_mending},
                                   {"sharp_before", result.sharp_before_mending},

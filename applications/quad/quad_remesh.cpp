@@ -1,5 +1,6 @@
 #include "applications/quad/quad_remesh.h"
 
+#include "applications/quad/quad_collapse.h"
 #include "applications/quad/quad_guard.h"
 #include "applications/quad/quad_templates.h"
 
@@ -629,6 +630,18 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         result.untangling.moves += last.moves;
         result.untangling.patches += last.patches;
         result.untangling.flipped_after = last.flipped_after;
+      }
+      if (bad_after > 0 && options.collapse_bad) {
+        // Still bad: removed by diagonal collapses (irregular vertices off P's corners).
+        const QuadCollapseResult collapsed =
+            collapse_bad_quads(result.mesh, result.grid, result.fitting.pinned, model, topology_only, options.untangle);
+        if (collapsed.collapsed > 0) {
+          report("untangle", std::to_string(collapsed.bad_before) + " flipped or degenerate quads left -> " +
+                                 std::to_string(collapsed.bad_after) + " by " + std::to_string(collapsed.collapsed) +
+                                 " diagonal collapses (" + std::to_string(collapsed.irregular_added) +
+                                 " more irregular vertices)");
+          result.collapsed_quads += collapsed.collapsed;
+        }
       }
       result.seconds_untangle += since(begin);
     }

@@ -24,6 +24,9 @@
 //                                                quads they split, relaxed round them, fitted
 //   quads   = untangle_quads(quads, M)          optional, when quads are bad: every vertex free,
 //                                                collapsed quads bad too, patches laid out again
+//   quads   = collapse_bad_quads(quads, M)      optional, when quads are still bad: each removed
+//                                                by a diagonal collapse (quad_collapse.h;
+//                                                irregular vertices off P's corners)
 //   quads   = untangle_quads(quads, M)          optional (mend_corners): inverted and sharp
 //                                                corners too; kept when the quads miss M no farther
 //   quality = measure_quads(quads, M, corners)
@@ -65,6 +68,9 @@ struct QuadRemeshOptions {
   // QuadUntangleOptions::inverted, sharp_degrees), held where the quads would miss the model
   // farther.
   bool mend_corners = true;
+  // Quads still flipped or degenerate after the last untangling removed by diagonal collapses
+  // (quad_collapse.h), when that leaves fewer of them.
+  bool collapse_bad = true;
   QuadQualityOptions quality;
   bool measure = true;  // false: skip measure_quads
 };
@@ -96,6 +102,7 @@ struct QuadRemeshResult {
   int inverted_before_mending = -1, sharp_before_mending = -1;
   int mending_tries = 0;
   bool mending_kept = false;
+  int collapsed_quads = 0;  // bad quads removed by diagonal collapses (collapse_bad)
   QuadQuality quality;
   double seconds_grid = 0;
   double seconds_carry = 0;
