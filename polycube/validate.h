@@ -12,7 +12,7 @@
 namespace polycube {
 
 struct PrepareOptions {
-  // Close every boundary loop with CGAL's hole filling (triangulate, refine, fair).
+  // Close every boundary loop with CGAL's hole filling (triangulate and refine, no fairing).
   bool fill_holes = false;
   // Keep only the component with the most faces.
   bool largest_component = false;
