@@ -140,112 +140,124 @@ QuadCollapseResult collapse_bad_quads(QuadMesh& quads, PolycubeGrid& grid, std::
       vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
       return vertices;
     };
-    for (int q : bad) {
-      if (failed.count(key(q))) continue;
-      // What a collapse of q can change: the quads within kCollapseRings + 2 rings of q (the
-      // untangling moves vertices within kCollapseRings rings of the merged vertex).
-      const std::vector<int> region = quads_round(mesh, around, q, kCollapseRings + 2);
-      std::vector<int> region_after;  // the same quads after the collapse (q dropped, rows shift)
-      for (int r : region)
-        if (r != q) region_after.push_back(r < q ? r : r - 1);
-      const int bad_here = bad_among(mesh, region, model, topology_only);
-      Collapse best;
-      QuadMesh best_mesh;
-      std::vector<int> best_index;
-      int best_bad = bad_here;
-      std::vector<Collapse> tried;  // every collapse that keeps a 2-manifold, every place
-      for (int diagonal = 0; diagonal < 2 && best_bad > 0; ++diagonal) {
-        const int u = mesh.Q(q, diagonal), w = mesh.Q(q, diagonal + 2);
-        const int s = mesh.Q(q, diagonal + 1), t = mesh.Q(q, (diagonal + 3) % 4);
-        if (corner[u] && corner[w]) continue;
-        if (around[s].size() < 4 || around[t].size() < 4) continue;
-        const std::vector<int> su = star(u), sw = star(w);
-        std::vector<int> shared;
-        std::set_intersection(su.begin(), su.end(), sw.begin(), sw.end(), std::back_inserter(shared));
-        if (std::any_of(shared.begin(), shared.end(), [&](int x) { return x != u && x != w && x != s && x != t; })) continue;
-        Collapse c;
-        c.q = q;
-        c.keep = corner[w] ? w : u;
-        c.gone = c.keep == u ? w : u;
-        std::vector<std::pair<Eigen::Vector3d, int>> places;
-        if (corner[c.keep]) {
-          places.emplace_back(mesh.V.row(c.keep).transpose(), c.keep);
-        } else {
-          places.emplace_back(model.closest(0.5 * (mesh.V.row(u) + mesh.V.row(w)).transpose()).point, -1);
-          places.emplace_back(mesh.V.row(u).transpose(), u);
-          places.emplace_back(mesh.V.row(w).transpose(), w);
+    for (int b : bad) {
+      if (failed.count(key(b))) continue;
+      // The bad quad first, then the quads sharing an edge with it: collapsing one of those can
+      // free a bad quad whose own diagonals cannot go (a valence-3 corner beside it).
+      std::vector<int> targets{b};
+      for (int k = 0; k < 4; ++k) {
+        const std::vector<int>& next = around[mesh.Q(b, (k + 1) % 4)];
+        for (int r : around[mesh.Q(b, k)])
+          if (r != b && std::find(next.begin(), next.end(), r) != next.end()) targets.push_back(r);
+      }
+      bool taken = false;
+      for (int q : targets) {
+        // What a collapse of q can change: the quads within kCollapseRings + 2 rings of q (the
+        // untangling moves vertices within kCollapseRings rings of the merged vertex).
+        const std::vector<int> region = quads_round(mesh, around, q, kCollapseRings + 2);
+        std::vector<int> region_after;  // the same quads after the collapse (q dropped, rows shift)
+        for (int r : region)
+          if (r != q) region_after.push_back(r < q ? r : r - 1);
+        const int bad_here = bad_among(mesh, region, model, topology_only);
+        Collapse best;
+        QuadMesh best_mesh;
+        std::vector<int> best_index;
+        int best_bad = bad_here;
+        std::vector<Collapse> tried;  // every collapse that keeps a 2-manifold, every place
+        for (int diagonal = 0; diagonal < 2 && best_bad > 0; ++diagonal) {
+          const int u = mesh.Q(q, diagonal), w = mesh.Q(q, diagonal + 2);
+          const int s = mesh.Q(q, diagonal + 1), t = mesh.Q(q, (diagonal + 3) % 4);
+          if (corner[u] && corner[w]) continue;
+          if (around[s].size() < 4 || around[t].size() < 4) continue;
+          const std::vector<int> su = star(u), sw = star(w);
+          std::vector<int> shared;
+          std::set_intersection(su.begin(), su.end(), sw.begin(), sw.end(), std::back_inserter(shared));
+          const auto outside = [&](int x) { return x != u && x != w && x != s && x != t; };
+          if (std::any_of(shared.begin(), shared.end(), outside)) continue;
+          Collapse c;
+          c.q = q;
+          c.keep = corner[w] ? w : u;
+          c.gone = c.keep == u ? w : u;
+          std::vector<std::pair<Eigen::Vector3d, int>> places;
+          if (corner[c.keep]) {
+            places.emplace_back(mesh.V.row(c.keep).transpose(), c.keep);
+          } else {
+            places.emplace_back(model.closest(0.5 * (mesh.V.row(u) + mesh.V.row(w)).transpose()).point, -1);
+            places.emplace_back(mesh.V.row(u).transpose(), u);
+            places.emplace_back(mesh.V.row(w).transpose(), w);
+          }
+          for (const auto& [place, from] : places) {
+            c.place = place;
+            c.from = from;
+            tried.push_back(c);
+            std::vector<int> index;
+            QuadMesh candidate = collapsed(mesh, c, index);
+            const int n = bad_among(candidate, region_after, model, topology_only);
+            if (n < best_bad) {
+              best_bad = n;
+              best = c;
+              best_mesh = std::move(candidate);
+              best_index = std::move(index);
+              if (n == 0) break;
+            }
+          }
         }
-        for (const auto& [place, from] : places) {
-          c.place = place;
-          c.from = from;
-          tried.push_back(c);
+        // No place lowers the bad quads: the quads round the merged vertex untangled (its rings;
+        // the rest held), a few times in all.
+        for (const Collapse& c : tried) {
+          if (best_bad < bad_here || untangles_left <= 0) break;
+          --untangles_left;
           std::vector<int> index;
-          QuadMesh candidate = collapsed(mesh, c, index);
-          const int n = bad_among(candidate, region_after, model, topology_only);
+          const QuadMesh candidate = collapsed(mesh, c, index);
+          const std::vector<std::vector<int>> near = vertex_quads(candidate.Q, candidate.num_vertices());
+          std::vector<char> fixed(candidate.num_vertices(), 1);
+          for (int r : quads_round(candidate, near, near[index[c.keep]].front(), kCollapseRings))
+            for (int k = 0; k < 4; ++k) fixed[candidate.Q(r, k)] = 0;
+          QuadUntangleResult untangled = untangle_quads(candidate, model, moves, fixed);
+          const int n = bad_among(untangled.mesh, region_after, model, topology_only);
           if (n < best_bad) {
             best_bad = n;
             best = c;
-            best_mesh = std::move(candidate);
+            best.from = -1;  // moved by the untangling
+            best_mesh = std::move(untangled.mesh);
             best_index = std::move(index);
-            if (n == 0) break;
           }
         }
-      }
-      // No place lowers the bad quads: the quads round the merged vertex untangled (its rings;
-      // the rest held), a few times in all.
-      for (const Collapse& c : tried) {
-        if (best_bad < bad_here || untangles_left <= 0) break;
-        --untangles_left;
+        if (best_bad >= bad_here) continue;
+        // Taken: the grid, the corners and the pinned flags follow the vertices.
+        const int keep = best.keep, gone = best.gone;
+        if (best.from == gone) {
+          on_p.mesh.V.row(keep) = on_p.mesh.V.row(gone);
+          on_p.on_polycube[keep] = on_p.on_polycube[gone];
+        }
+        const bool pinned_place = best.from >= 0 && held[best.from];
+        Collapse bookkeeping = best;
+        bookkeeping.place = on_p.mesh.V.row(keep).transpose();
         std::vector<int> index;
-        const QuadMesh candidate = collapsed(mesh, c, index);
-        const std::vector<std::vector<int>> near = vertex_quads(candidate.Q, candidate.num_vertices());
-        std::vector<char> fixed(candidate.num_vertices(), 1);
-        for (int r : quads_round(candidate, near, near[index[c.keep]].front(), kCollapseRings))
-          for (int k = 0; k < 4; ++k) fixed[candidate.Q(r, k)] = 0;
-        QuadUntangleResult untangled = untangle_quads(candidate, model, moves, fixed);
-        const int n = bad_among(untangled.mesh, region_after, model, topology_only);
-        if (n < best_bad) {
-          best_bad = n;
-          best = c;
-          best.from = -1;  // moved by the untangling
-          best_mesh = std::move(untangled.mesh);
-          best_index = std::move(index);
-        }
+        on_p.mesh = collapsed(on_p.mesh, bookkeeping, index);
+        std::vector<SurfacePoint> points(best_mesh.num_vertices());
+        std::vector<char> flags(best_mesh.num_vertices(), 0);
+        for (int v = 0; v < static_cast<int>(index.size()); ++v)
+          if (index[v] >= 0) {
+            points[index[v]] = on_p.on_polycube[v];
+            flags[index[v]] = held[v];
+          }
+        flags[index[keep]] = pinned_place;
+        on_p.on_polycube = std::move(points);
+        held = std::move(flags);
+        if (on_p.quad_axis.size() == mesh.num_quads()) on_p.quad_axis = without_row(on_p.quad_axis, best.q);
+        if (on_p.quad_cell.size() == mesh.num_quads()) on_p.quad_cell = without_row(on_p.quad_cell, best.q);
+        if (on_p.quad_refined_by.size() == mesh.num_quads())
+          on_p.quad_refined_by = without_row(on_p.quad_refined_by, best.q);
+        for (int& c : on_p.corners) c = index[c];
+        mesh = std::move(best_mesh);
+        bad = bad_quads(mesh, model, topology_only);
+        ++out.collapsed;
+        progress = taken = true;
+        break;
       }
-      if (best_bad >= bad_here) {
-        failed.insert(key(q));
-        continue;
-      }
-      // Taken: the grid, the corners and the pinned flags follow the vertices.
-      const int keep = best.keep, gone = best.gone;
-      if (best.from == gone) {
-        on_p.mesh.V.row(keep) = on_p.mesh.V.row(gone);
-        on_p.on_polycube[keep] = on_p.on_polycube[gone];
-      }
-      const bool pinned_place = best.from >= 0 && held[best.from];
-      Collapse bookkeeping = best;
-      bookkeeping.place = on_p.mesh.V.row(keep).transpose();
-      std::vector<int> index;
-      on_p.mesh = collapsed(on_p.mesh, bookkeeping, index);
-      std::vector<SurfacePoint> points(best_mesh.num_vertices());
-      std::vector<char> flags(best_mesh.num_vertices(), 0);
-      for (int v = 0; v < static_cast<int>(index.size()); ++v)
-        if (index[v] >= 0) {
-          points[index[v]] = on_p.on_polycube[v];
-          flags[index[v]] = held[v];
-        }
-      flags[index[keep]] = pinned_place;
-      on_p.on_polycube = std::move(points);
-      held = std::move(flags);
-      if (on_p.quad_axis.size() == mesh.num_quads()) on_p.quad_axis = without_row(on_p.quad_axis, best.q);
-      if (on_p.quad_cell.size() == mesh.num_quads()) on_p.quad_cell = without_row(on_p.quad_cell, best.q);
-      if (on_p.quad_refined_by.size() == mesh.num_quads()) on_p.quad_refined_by = without_row(on_p.quad_refined_by, best.q);
-      for (int& c : on_p.corners) c = index[c];
-      mesh = std::move(best_mesh);
-      bad = bad_quads(mesh, model, topology_only);
-      ++out.collapsed;
-      progress = true;
-      break;
+      if (taken) break;
+      failed.insert(key(b));
     }
   }
   if (out.collapsed == 0) return out;

@@ -40,12 +40,13 @@ const Mapped& mapped(const std::string& name) {
   return *slot;
 }
 
-QuadRemeshResult remesh(const Mapped& m, int quads, int sweeps, bool mend_corners = false) {
+QuadRemeshResult remesh(const Mapped& m, int quads, int sweeps, bool mend_corners = false, bool collapse_bad = false) {
   QuadRemeshOptions options;
   options.grid.target_quads = quads;
   options.smooth.sweeps = sweeps;
   options.refine.rounds = 0;  // the same grid either way: what the relaxation does is compared
   options.mend_corners = mend_corners;  // off: nor the mending at the end
+  options.collapse_bad = collapse_bad;  // off: the grid's connectivity, irregular only at P's cones
   const SurfaceMap to_model = [&m](const SurfacePoint& p) { return surface_position(m.model, m.map.to_model(p)); };
   return remesh_quads(m.polycube.polycube.mesh, to_model, *m.projector, options);
 }
@@ -98,6 +99,34 @@ TEST(QuadRemesh, MendsInvertedCornersAtTheEnd) {
             plain.quality.flipped_quads + plain.quality.degenerate_quads);
   ASSERT_TRUE(mended.quality.hausdorff_measured);
   EXPECT_LE(mended.quality.hausdorff, 1.01 * plain.quality.hausdorff + 1e-12);
+}
+
+// The diagonal collapses of the quads the last untangling leaves bad, on anchor's tangled map
+// (3 000 quads, relaxed): fewer bad quads, the same closed genus-g 2-manifold, a quad fewer per
+// collapse, at most 3 irregular vertices off P's cones per collapse, the grid still matching the
+// quads, every vertex on the model. Measured: 3 flipped quads -> 0 by 3 collapses, 7 irregular
+// vertices off P's cones.
+TEST(QuadRemesh, CollapsesTheQuadsLeftBad) {
+  const Mapped& m = mapped("anchor.off");
+  const QuadRemeshResult plain = remesh(m, 3000, 30);
+  const QuadRemeshResult collapsed = remesh(m, 3000, 30, false, true);
+  const int genus = (2 - (m.model.num_vertices() - 3 * m.model.num_faces() / 2 + m.model.num_faces())) / 2;
+  const auto bad = [](const QuadRemeshResult& r) { return r.quality.flipped_quads + r.quality.degenerate_quads; };
+  ASSERT_GT(bad(plain), 0) << "the test needs quads left bad";
+  EXPECT_EQ(plain.collapsed_quads, 0);
+  EXPECT_GT(collapsed.collapsed_quads, 0);
+  EXPECT_LT(bad(collapsed), bad(plain));
+  const QuadQuality& q = collapsed.quality;
+  EXPECT_TRUE(q.topology.closed_manifold());
+  EXPECT_EQ(q.topology.components, 1);
+  EXPECT_EQ(q.genus, genus);
+  EXPECT_EQ(collapsed.mesh.num_quads(), plain.mesh.num_quads() - collapsed.collapsed_quads);
+  EXPECT_EQ(collapsed.mesh.num_vertices(), plain.mesh.num_vertices() - collapsed.collapsed_quads);
+  EXPECT_LE(q.irregular_vertices - q.irregular_at_corners, 3 * collapsed.collapsed_quads);
+  EXPECT_EQ(collapsed.grid.mesh.Q, collapsed.mesh.Q);
+  EXPECT_EQ(static_cast<int>(collapsed.grid.on_polycube.size()), collapsed.mesh.num_vertices());
+  EXPECT_EQ(collapsed.grid.corners.size(), plain.grid.corners.size());
+  EXPECT_LE(q.max_distance_to_surface, 1e-9 * q.diagonal);
 }
 
 TEST(QuadSmooth, UntanglesFoldedQuadsOfATangledMap) {
