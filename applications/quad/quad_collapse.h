@@ -37,7 +37,9 @@ struct QuadCollapseResult {
 // (within 4 rings of the quad) is taken if that is fewer than before; when no place is, the
 // quads within 2 rings of the merged vertex are untangled (untangle_quads with `untangle`'s
 // vertex moves, no patches; the rest held) from each place in turn, at most 24 times per call.
-// A quad no collapse helps is not tried again.
+// When no collapse of the bad quad itself lowers them, the same for each quad sharing an edge
+// with it (a valence-3 vertex beside a bad quad can bar its own diagonals; elephant-with-holes'
+// last flipped quad went that way). A bad quad no collapse helps is not tried again.
 // Edits, consistently: quads (positions on the model), grid (its mesh on P, on_polycube, the
 // per-quad arrays, corners; the merged vertex keeps the place on P of the corner kept, or of the
 // corner whose place on the model it took) and pinned (per vertex; may be empty). Vertices keep

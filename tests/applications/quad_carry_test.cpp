@@ -39,19 +39,6 @@ const PolycubeResult& eight_polycube() {
   return result;
 }
 
-// The cube [-1, 1]^3 as 12 triangles, outward.
-TriMesh cube() {
-  TriMesh mesh;
-  mesh.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i) mesh.V.row(i) << (i & 1 ? 1 : -1), (i & 2 ? 1 : -1), (i & 4 ? 1 : -1);
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  mesh.F.resize(12, 3);
-  for (int q = 0; q < 6; ++q) {
-    mesh.F.row(2 * q) << quads[q][0], quads[q][1], quads[q][2];
-    mesh.F.row(2 * q + 1) << quads[q][0], quads[q][2], quads[q][3];
-  }
-  return mesh;
-}
 
 Eigen::Vector3d on_mesh(const TriMesh& mesh, const SurfacePoint& p) {
   return p.bary[0] * mesh.V.row(mesh.F(p.face, 0)).transpose() + p.bary[1] * mesh.V.row(mesh.F(p.face, 1)).transpose() +
@@ -131,7 +118,7 @@ TEST(QuadCarry, SmoothBijectionFlipsNothing) {
 }
 
 TEST(QuadCarry, ReflectionFlipsEveryQuad) {
-  const TriMesh P = cube();
+  const TriMesh P = test::make_cube();
   TriMesh M = P;
   M.V.col(0) *= -1;
   M.F.col(1).swap(M.F.col(2));  // outward again
@@ -149,9 +136,9 @@ TEST(QuadCarry, ReflectionFlipsEveryQuad) {
 }
 
 TEST(QuadCarry, NonFiniteImageIsAnError) {
-  const PolycubeGrid grid = build_polycube_grid(cube(), {});
+  const PolycubeGrid grid = build_polycube_grid(test::make_cube(), {});
   EXPECT_THROW(carry_grid(grid, [](const SurfacePoint&) { return Eigen::Vector3d(NAN, 0, 0); }), AlgorithmError);
-  EXPECT_THROW(vertex_image_map(cube(), Eigen::MatrixX3d::Zero(3, 3)), std::invalid_argument);
+  EXPECT_THROW(vertex_image_map(test::make_cube(), Eigen::MatrixX3d::Zero(3, 3)), std::invalid_argument);
   // On several threads too, the error names the lowest failing vertex (the images of the grid's
   // last half are not finite), not the one a thread happened to meet first.
   const int nv = grid.mesh.num_vertices();
@@ -190,9 +177,9 @@ CubeSphere cube_sphere(int target) {
   CubeSphere c;
   PolycubeGridOptions options;
   options.target_quads = target;
-  c.grid = build_polycube_grid(cube(), options);
+  c.grid = build_polycube_grid(test::make_cube(), options);
   c.sphere = std::make_shared<const SurfaceProjector>(test::make_sphere(4));
-  const TriMesh P = cube();
+  const TriMesh P = test::make_cube();
   c.quads = carry_grid(c.grid, projected_map([P](const SurfacePoint& p) { return on_mesh(P, p).normalized().eval(); }, c.sphere));
   return c;
 }
@@ -295,7 +282,7 @@ const HornedSphere& horned_sphere() {
     h.model = std::make_shared<const SurfaceProjector>(horned);
     PolycubeGridOptions fine;
     fine.target_quads = 6 * 40 * 40;
-    h.P = triangulate_quads(build_polycube_grid(cube(), fine).mesh);
+    h.P = triangulate_quads(build_polycube_grid(test::make_cube(), fine).mesh);
     h.radial = projected_map([P = h.P](const SurfacePoint& p) { return on_mesh(P, p).normalized().eval(); }, h.model);
     return h;
   }();
@@ -597,7 +584,7 @@ TEST(QuadCarry, MissesComeWithThePlaceUnderTheQuads) {
 }
 
 TEST(QuadCarry, SameGridVerticesOfARefinedGrid) {
-  const TriMesh P = cube();
+  const TriMesh P = test::make_cube();
   PolycubeGridOptions options;
   options.target_quads = 600;
   const PolycubeGrid coarse = build_polycube_grid(P, options);
@@ -747,7 +734,7 @@ TEST(QuadCarry, FitStretchesTheQuadsOntoAFarTip) {
 TEST(QuadCarry, FitPullsCornersOntoCreasesOfACoarseModel) {
   const CubeSphere c = cube_sphere(1500);
   const Eigen::Matrix3d turn = (Eigen::AngleAxisd(0.35, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
-  TriMesh box = cube();
+  TriMesh box = test::make_cube();
   box.V = (box.V * turn.transpose()).eval();
   const SurfaceProjector model(box);
   QuadMesh quads = c.quads;
@@ -781,7 +768,7 @@ TEST(QuadCarry, FitPullsCornersOntoCreasesOfACoarseModel) {
 // The points a coarse mesh is measured and fitted at: on a cube of 12 triangles with edges of 2,
 // its 8 vertices, the 12 centroids, and points along the 18 edges at most `spacing` apart.
 TEST(QuadCarry, SurfaceSamplesAlongLongEdges) {
-  const TriMesh box = cube();
+  const TriMesh box = test::make_cube();
   const SurfaceSamples samples = sample_surface(box, 0.5);
   ASSERT_EQ(samples.points.size(), samples.hint_vertex.size());
   // 12 sides of 2: 4 parts, 3 points each; 6 diagonals of 2.83: 6 parts, 5 points each.

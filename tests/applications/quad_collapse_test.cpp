@@ -8,6 +8,8 @@
 #include "applications/quad/quad_quality.h"
 #include "applications/quad/surface_projector.h"
 
+#include "support/generated_meshes.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,19 +18,6 @@
 namespace polycube {
 namespace {
 
-// The cube [-1, 1]^3 as 12 triangles, outward.
-TriMesh cube() {
-  TriMesh mesh;
-  mesh.V.resize(8, 3);
-  for (int i = 0; i < 8; ++i) mesh.V.row(i) << (i & 1 ? 1 : -1), (i & 2 ? 1 : -1), (i & 4 ? 1 : -1);
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  mesh.F.resize(12, 3);
-  for (int q = 0; q < 6; ++q) {
-    mesh.F.row(2 * q) << quads[q][0], quads[q][1], quads[q][2];
-    mesh.F.row(2 * q + 1) << quads[q][0], quads[q][2], quads[q][3];
-  }
-  return mesh;
-}
 
 struct CubeCase {
   PolycubeGrid grid;
@@ -44,7 +33,7 @@ CubeCase make_setup(double past) {
   CubeCase s;
   PolycubeGridOptions options;
   options.target_quads = 600;
-  s.grid = build_polycube_grid(cube(), options);
+  s.grid = build_polycube_grid(test::make_cube(), options);
   s.quads = s.grid.mesh;
   s.pinned.assign(s.quads.num_vertices(), 0);
   for (int v = 0; v < s.quads.num_vertices(); v += 2) s.pinned[v] = 1;
@@ -72,7 +61,7 @@ int irregular(const QuadMesh& quads) {
 
 void expect_collapsed(CubeCase s, const char* what) {
   SCOPED_TRACE(what);
-  const SurfaceProjector model(cube());
+  const SurfaceProjector model(test::make_cube());
   ASSERT_EQ(bad_quads(s.quads, model), std::vector<int>{s.target});
   const int nv = s.quads.num_vertices(), nq = s.quads.num_quads(), was_irregular = irregular(s.quads);
   std::vector<Eigen::Vector3d> corner_places;
@@ -118,7 +107,7 @@ TEST(QuadCollapse, DegenerateQuadRemoved) { expect_collapsed(make_setup(0), "deg
 TEST(QuadCollapse, FlippedQuadRemoved) { expect_collapsed(make_setup(0.05), "flipped"); }
 
 TEST(QuadCollapse, NothingBadNothingChanged) {
-  const SurfaceProjector model(cube());
+  const SurfaceProjector model(test::make_cube());
   CubeCase s = make_setup(-0.5);  // corners back at their places: the plain grid
   const QuadMesh before = s.quads;
   const QuadCollapseResult r = collapse_bad_quads(s.quads, s.grid, s.pinned, model);
@@ -131,7 +120,7 @@ TEST(QuadCollapse, NothingBadNothingChanged) {
 TEST(QuadCollapse, QuadAtAPolycubeCornerCollapsesOntoIt) {
   // A quad at a cube corner made degenerate (its corner opposite the cube's put on it): the
   // collapse keeps the cube's corner where it is, with 5 quads round it now, and still a corner.
-  const SurfaceProjector model(cube());
+  const SurfaceProjector model(test::make_cube());
   CubeCase s = make_setup(-0.5);  // the plain grid
   const int corner = s.grid.corners.front();
   const Eigen::Vector3d place = s.quads.V.row(corner);
@@ -155,7 +144,7 @@ TEST(QuadCollapse, QuadAtAPolycubeCornerCollapsesOntoIt) {
 }
 
 TEST(QuadCollapse, MismatchedGridThrows) {
-  const SurfaceProjector model(cube());
+  const SurfaceProjector model(test::make_cube());
   CubeCase s = make_setup(0);
   s.grid.on_polycube.pop_back();
   EXPECT_THROW(collapse_bad_quads(s.quads, s.grid, s.pinned, model), std::invalid_argument);

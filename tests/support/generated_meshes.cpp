@@ -402,6 +402,19 @@ TriMesh make_genus_surface(int genus, int resolution) {
   return polygonise(genus == 0 ? ellipsoid() : grid_graph_tube(genus), resolution);
 }
 
+TriMesh make_cube() {
+  TriMesh mesh;
+  mesh.V.resize(8, 3);
+  for (int i = 0; i < 8; ++i) mesh.V.row(i) << (i & 1 ? 1 : -1), (i & 2 ? 1 : -1), (i & 4 ? 1 : -1);
+  const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  mesh.F.resize(12, 3);
+  for (int q = 0; q < 6; ++q) {
+    mesh.F.row(2 * q) << faces[q][0], faces[q][1], faces[q][2];
+    mesh.F.row(2 * q + 1) << faces[q][0], faces[q][2], faces[q][3];
+  }
+  return mesh;
+}
+
 TriMesh make_sphere(int subdivisions) {
   if (subdivisions < 0)
     throw std::invalid_argument("make_sphere: need subdivisions >= 0, got " + std::to_string(subdivisions));

@@ -37,6 +37,9 @@ TriMesh make_genus_surface(int genus, int resolution = 48);
 // Returns 10*4^s + 2 vertices and 20*4^s triangles.
 TriMesh make_sphere(int subdivisions);
 
+// The cube [-1, 1]^3 as 12 outward triangles (two per face): a polycube with 8 corners.
+TriMesh make_cube();
+
 // Open tube around the z axis: n vertices around, rows + 1 rings from z = 0 to z = height,
 // quads split along alternating diagonals, outward-oriented; two boundary loops (genus 0).
 TriMesh make_tube(double radius, double height, int n, int rows);
