@@ -56,7 +56,7 @@ CubeCase make_setup(double past) {
 
 int irregular(const QuadMesh& quads) {
   const QuadTopology t = quad_topology(quads);
-  return static_cast<int>(std::count_if(t.valence.data(), t.valence.data() + t.valence.size(), [](int n) { return n != 4; }));
+  return static_cast<int>((t.valence.array() != 4).count());
 }
 
 void expect_collapsed(CubeCase s, const char* what) {
