@@ -67,7 +67,6 @@ Matrix without_row(const Matrix& rows, int q) {
   return out;
 }
 
-
 // The quads within `rings` rings of quad `seed` (sharing a vertex, ring by ring), seed first.
 std::vector<int> quads_round(const QuadMesh& mesh, const std::vector<std::vector<int>>& around, int seed, int rings) {
   std::vector<int> out{seed};
