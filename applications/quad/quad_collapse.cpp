@@ -19,13 +19,6 @@ constexpr int kCollapseUntangles = 24;
 // what collapses mend, and loses to the others anyway).
 constexpr int kCollapseMost = 64;
 
-int irregular_count(const Eigen::MatrixX4i& Q, int num_vertices) {
-  std::vector<int> valence(num_vertices, 0);
-  for (int q = 0; q < Q.rows(); ++q)
-    for (int k = 0; k < 4; ++k) ++valence[Q(q, k)];
-  return static_cast<int>(std::count_if(valence.begin(), valence.end(), [](int n) { return n != 0 && n != 4; }));
-}
-
 // One collapse: quad q removed, vertex `gone` merged into `keep`, which goes to `place` (the
 // place of corner `from`, or, -1, another point).
 struct Collapse {
@@ -115,7 +108,8 @@ QuadCollapseResult collapse_bad_quads(QuadMesh& quads, PolycubeGrid& grid, std::
   std::vector<char> held = pinned;
   held.resize(nv, 0);
   int untangles_left = kCollapseUntangles;
-  QuadUntangleOptions moves = untangle;  // vertex moves only: patches cost 80 % of the time
+  // Vertex moves only: with patches, femur's first try (34 bad quads) took 18.7 s instead of 2.6.
+  QuadUntangleOptions moves = untangle;
   moves.patch_rings = 0;
   // Quads no collapse helped, by their corners' places (indices change with every collapse).
   std::set<std::array<double, 12>> failed;
@@ -271,7 +265,10 @@ QuadCollapseResult collapse_bad_quads(QuadMesh& quads, PolycubeGrid& grid, std::
     return out;
   }
   out.bad_after = static_cast<int>(bad.size());
-  out.irregular_added = irregular_count(mesh.Q, mesh.num_vertices()) - irregular_count(quads.Q, nv);
+  const auto irregular = [](const QuadTopology& t) {
+    return static_cast<int>(((t.valence.array() != 4) && (t.valence.array() != 0)).count());
+  };
+  out.irregular_added = irregular(topology) - irregular(was);
   quads = std::move(mesh);
   grid = std::move(on_p);
   if (!pinned.empty()) pinned = std::move(held);
