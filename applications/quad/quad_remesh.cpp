@@ -638,8 +638,9 @@ QuadRemeshResult remesh_quads(const TriMesh& polycube, const SurfaceMap& to_mode
         if (collapsed.collapsed > 0) {
           report("untangle", std::to_string(collapsed.bad_before) + " flipped or degenerate quads left -> " +
                                  std::to_string(collapsed.bad_after) + " by " + std::to_string(collapsed.collapsed) +
-                                 " diagonal collapses (" + std::to_string(collapsed.irregular_added) +
-                                 " more irregular vertices)");
+                                 " diagonal collapses (irregular vertices " +
+                                 (collapsed.irregular_added >= 0 ? "+" : "") + std::to_string(collapsed.irregular_added) +
+                                 ")");
           result.collapsed_quads += collapsed.collapsed;
         }
       }
