@@ -76,13 +76,25 @@ std::vector<int> quads_round(const QuadMesh& mesh, const std::vector<std::vector
   return out;
 }
 
-// How many of the quads `which` of mesh are bad (bad_quads).
+// How many of the quads `which` of mesh are bad (bad_quads), judged on a mesh of those quads and
+// their vertices alone.
 int bad_among(const QuadMesh& mesh, const std::vector<int>& which, const SurfaceProjector& model,
               const QuadQualityOptions& options) {
   QuadMesh sub;
-  sub.V = mesh.V;
+  std::vector<int> index(mesh.num_vertices(), -1);
+  std::vector<int> used;
   sub.Q.resize(static_cast<Eigen::Index>(which.size()), 4);
-  for (size_t i = 0; i < which.size(); ++i) sub.Q.row(static_cast<Eigen::Index>(i)) = mesh.Q.row(which[i]);
+  for (size_t i = 0; i < which.size(); ++i)
+    for (int k = 0; k < 4; ++k) {
+      int& slot = index[mesh.Q(which[i], k)];
+      if (slot < 0) {
+        slot = static_cast<int>(used.size());
+        used.push_back(mesh.Q(which[i], k));
+      }
+      sub.Q(static_cast<Eigen::Index>(i), k) = slot;
+    }
+  sub.V.resize(static_cast<Eigen::Index>(used.size()), 3);
+  for (size_t i = 0; i < used.size(); ++i) sub.V.row(static_cast<Eigen::Index>(i)) = mesh.V.row(used[i]);
   return static_cast<int>(bad_quads(sub, model, options).size());
 }
 
@@ -108,7 +120,8 @@ QuadCollapseResult collapse_bad_quads(QuadMesh& quads, PolycubeGrid& grid, std::
   std::vector<char> held = pinned;
   held.resize(nv, 0);
   int untangles_left = kCollapseUntangles;
-  // Vertex moves only: with patches, femur's first try (34 bad quads) took 18.7 s instead of 2.6.
+  // Vertex moves only: with patches, the collapses on a femur try's quads (dumped, 34 bad) took
+  // 18.7 s instead of 2.6.
   QuadUntangleOptions moves = untangle;
   moves.patch_rings = 0;
   // Quads no collapse helped, by their corners' places (indices change with every collapse).
@@ -154,7 +167,6 @@ QuadCollapseResult collapse_bad_quads(QuadMesh& quads, PolycubeGrid& grid, std::
         const int bad_here = bad_among(mesh, region, model, topology_only);
         Collapse best;
         QuadMesh best_mesh;
-        std::vector<int> best_index;
         int best_bad = bad_here;
         std::vector<Collapse> tried;  // every collapse that keeps a 2-manifold, every place
         for (int diagonal = 0; diagonal < 2 && best_bad > 0; ++diagonal) {
@@ -190,7 +202,6 @@ QuadCollapseResult collapse_bad_quads(QuadMesh& quads, PolycubeGrid& grid, std::
               best_bad = n;
               best = c;
               best_mesh = std::move(candidate);
-              best_index = std::move(index);
               if (n == 0) break;
             }
           }
@@ -213,7 +224,6 @@ QuadCollapseResult collapse_bad_quads(QuadMesh& quads, PolycubeGrid& grid, std::
             best = c;
             best.from = -1;  // moved by the untangling
             best_mesh = std::move(untangled.mesh);
-            best_index = std::move(index);
           }
         }
         if (best_bad >= bad_here) continue;
