@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 #include <new>
+#include <sstream>
 
 namespace polycube::cli {
 
@@ -24,6 +25,27 @@ void Progress::warning(const std::string& message) const {
 
 double Progress::elapsed_seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+bool TimeLimit::spent(const Progress& progress) {
+  if (seconds > 0 && progress.elapsed_seconds() >= seconds) reached = true;
+  return reached;
+}
+
+void TimeLimit::warn(const Progress& progress, const std::string& what) const {
+  if (!reached) return;
+  std::ostringstream text;
+  text << "--time-limit " << seconds << " s reached: " << what << " not tried";
+  progress.warning(text.str());
+}
+
+void add_time_limit_option(CLI::App& command, TimeLimit& limit) {
+  command
+      .add_option("--time-limit", limit.seconds,
+                  "Seconds after which no further try starts (other orientations, finer contours, thin parts, exact "
+                  "sampling); the try under way finishes and the best so far is written, with a warning; 0: no limit")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
 }
 
 namespace {

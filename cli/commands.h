@@ -39,6 +39,19 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
 };
 
+// --time-limit of `map` and `quad`: once a command has a result, it starts no further try
+// (another orientation, finer contours, thin parts, an exact sampling) after this many seconds
+// from its start; the try under way finishes and the best so far is written. 0: no limit.
+struct TimeLimit {
+  double seconds = 0;
+  bool reached = false;  // a try was left out for it
+  // True, and `reached` set, when the limit is set and spent: the caller starts no further try.
+  bool spent(const Progress& progress);
+  // "--time-limit S s reached: <what> not tried" as a warning (once), when reached.
+  void warn(const Progress& progress, const std::string& what) const;
+};
+void add_time_limit_option(CLI::App& command, TimeLimit& limit);
+
 // Each subcommand registers itself on the app and sets the callback that runs it.
 // The callback returns the exit code; exceptions are mapped to exit codes by run().
 using CommandRunner = std::function<int()>;

@@ -60,6 +60,7 @@ struct MapOptions {
   // exact sampling of their unsmoothed maps (map_overlay.h), best-ranked first, kept where it
   // ranks better.
   bool exact = true;
+  TimeLimit time_limit;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -468,6 +469,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   report["parameters"]["untangle_shift"] = options.untangle_shift;
   report["parameters"]["untangle_shift_max"] = options.untangle_shift_max;
   report["parameters"]["finer_contours"] = options.finer_contours;
+  TimeLimit time_limit = options.time_limit;
   std::vector<std::string> outputs;
   // Self-intersecting: every stage runs on the separated copy; P's images on it go back to the
   // model at the end, where the files are audited (below).
@@ -518,6 +520,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     if (first_choice.empty()) first_choice = attempts[first]->name;
     for (size_t i = first; i < attempts.size(); ++i) {
       Attempt& a = *attempts[i];
+      if (kept && time_limit.spent(progress)) return;
       if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
       run_stages(a, source, pass, progress);
       if (!a.finished) {
@@ -535,7 +538,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   // 7 % of the diagonal from P's image, 0.972 of the area at d_a 0.3; at 0.1 the orientations
   // rank differently and the new first one gives 0.981). A finer P can also flip more: the
   // maps compete by rank.
-  if (kept && kept->finished && !kept->finished->meets_contract() && options.finer_contours > 1) {
+  if (kept && kept->finished && !kept->finished->meets_contract() && options.finer_contours > 1 && !time_limit.spent(progress)) {
     MapOptions finer = options;
     finer.polycube.da = options.polycube.da / options.finer_contours;
     std::ostringstream suffix;
@@ -557,6 +560,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (a->finished && a->map) order.push_back(a.get());
     std::stable_sort(order.begin(), order.end(), [](const Attempt* x, const Attempt* y) { return x->finished->rank() < y->finished->rank(); });
     for (Attempt* a : order) {
+      if (time_limit.spent(progress)) break;
       progress.stage("retry", shortfall() + "the exact sampling of " + a->name);
       const double start = progress.elapsed_seconds();
       std::unique_ptr<Finished> exact;
@@ -585,6 +589,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (kept->finished->meets_contract()) break;
     }
   }
+  time_limit.warn(progress, "other orientations, finer contours and exact samplings");
+  if (time_limit.seconds > 0) report["time_limit"] = {{"seconds", time_limit.seconds}, {"reached", time_limit.reached}};
   if (separation && kept->finished) {
     // P's images on the copy, moved to the same faces and barycentric coordinates of the model;
     // the audit on the copy goes to the report, the files' audit on the model is made below.
@@ -820,6 +826,7 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "divided by this (finer contours keep thin parts such as tails and horns); 1: never")
       ->check(CLI::Range(1.0, 100.0))
       ->capture_default_str();
+  add_time_limit_option(*command, options->time_limit);
   command->add_flag("--no-exact{false}", options->exact,
                    "When no finished map is free of flipped triangles with the area within 2 %, do not try the exact sampling "
                    "last (P triangulated by both disk triangulations of every piece, where the unsmoothed map is affine on each "

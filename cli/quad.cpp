@@ -61,6 +61,7 @@ struct QuadCommandOptions {
   // The model's edges longer than this times the quad size are split before the map is built
   // (split_long_edges); 0: never.
   double split_edges = 2;
+  TimeLimit time_limit;
   TopologyOptions topology;
   PolycubeOptions polycube;
 };
@@ -459,6 +460,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // More quads than this (refine_bound_growth times the target) is a layout too fine for the
   // size asked (a polycube with many corners); 0 with --cell-size.
   const double most_quads = options.cell_size > 0 ? 0 : options.refine_bound_growth * options.target_faces;
+  TimeLimit time_limit = options.time_limit;
   const auto shortfall = [&]() {
     if (!kept->worth_retrying() && kept->more_than(most_quads))
       return "the quads are many more than asked (" + std::to_string(kept->result->quality.quads) + " for " +
@@ -471,6 +473,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   const auto remesh_from = [&](size_t first) {
     for (size_t i = first; i < attempts.size(); ++i) {
       QuadAttempt& a = *attempts[i];
+      if (kept && time_limit.spent(progress)) return;
       if (kept) progress.stage("retry", shortfall() + a.name);
       if (!a.result) {
         try {
@@ -493,6 +496,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // minutes): its tries are capped as every try after the first (add_attempts).
   const auto search_again = [&](const PolycubeOptions& polycube, const std::string& key, const std::string& suffix,
                                 const std::string& what, const QuadModel& on) {
+    if (time_limit.spent(progress)) return;
     progress.stage("retry", shortfall() + "all over again " + what);
     const size_t first = attempts.size();
     try {
@@ -547,6 +551,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     suffix << ", thin parts kept (" << thin.feature_distance << ")" << model_suffix(*on);
     search_again(thin, model_key("thin_parts", *on), suffix.str(), "keeping thin parts" + std::string(model_suffix(*on)), *on);
   }
+  time_limit.warn(progress, "other orientations, finer contours and thin parts");
+  if (time_limit.seconds > 0) report["time_limit"] = {{"seconds", time_limit.seconds}, {"reached", time_limit.reached}};
   {
     // The kept try's corners mended (the other tries are only compared).
     QuadRemeshOptions mend = remesh;
@@ -777,6 +783,7 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
                       "with --map); 0: never")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  add_time_limit_option(*command, options->time_limit);
   command->add_option("--split-edges", options->split_edges,
                       "Before building the map, split the model's edges longer than this times the quad size (same surface; a "
                       "coarse CAD model's map shears the quads otherwise; not with --map); 0: never")

@@ -272,6 +272,35 @@ TEST(QuadCli, QuadsStillShortTryFinerContours) {
 // map is built: the map's disk maps on 4 triangles shear the quads (about 29 deg mean angle
 // deviation from 90 at 1000 quads, one orientation, no refinement), on the split model they do
 // not (about 9). The quads lie on the model as read and are measured against it.
+// --time-limit: once the first try has quads, no further try starts after the limit. Eight at 200
+// quads without refinement falls short of the bound on every try (QuadsStillShortTryFinerContours
+// runs the same command without a limit and makes several tries); with a limit already spent
+// only the first try is made, its quads are written, and the warning and the report say so.
+TEST(QuadCli, TimeLimitStopsFurtherTries) {
+  const std::string dir = test::temp_dir("quad-time-limit");
+  const std::string out = dir + "/eight.obj", report_path = dir + "/report.json";
+  const test::CliRun run =
+      polycube_cli("quad " + quoted(test::data_path("eight.off")) + " --target-faces 200 --refine 0 --refine-bound 0 --thin-parts 0" +
+                   " --time-limit 0.001 -o " + quoted(out) + " --report " + quoted(report_path));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("warning: --time-limit 0.001 s reached: other orientations"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("retry:"), std::string::npos) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
+  EXPECT_TRUE(report.at("time_limit").at("reached").get<bool>());
+  EXPECT_DOUBLE_EQ(report.at("time_limit").at("seconds").get<double>(), 0.001);
+  EXPECT_FALSE(report.at("alignment").contains("tried")) << "one try only";
+  EXPECT_GT(report.at("quality").at("hausdorff_percent_diagonal").get<double>(), 0.5) << "the first try met the bound: pick another case";
+  const QuadMesh quads = read_quads(out);
+  EXPECT_EQ(report.at("quality").at("quads").get<int>(), quads.num_quads());
+  // A limit not reached changes nothing and says so.
+  const std::string roomy = dir + "/roomy.json";
+  const test::CliRun generous = polycube_cli("quad --quiet " + quoted(test::data_path("sphere.off")) + " --target-faces 300 --time-limit 1000000 -o " +
+                                             quoted(dir + "/sphere.obj") + " --report " + quoted(roomy));
+  ASSERT_EQ(generous.code, 0) << generous.err;
+  EXPECT_FALSE(nlohmann::json::parse(test::read_file(roomy)).at("time_limit").at("reached").get<bool>());
+  EXPECT_NE(polycube_cli("quad --quiet " + quoted(test::data_path("sphere.off")) + " -o " + quoted(dir + "/x.obj") + " --time-limit -1").code, 0);
+}
+
 // Every try after the first is capped at 1.5 × --refine-bound-growth × --target-faces quads:
 // eight at 50 quads (cap 225) falls short of the bound, and the orientation search's next
 // candidates, whose layouts need 611 cells, are given up at once with why; the first try, never

@@ -197,6 +197,23 @@ std::tuple<int, int, double, double> finished_rank(const nlohmann::json& f) {
                          f.at("eps_angle").get<double>());
 }
 
+// --time-limit: helmet's first finished map falls short of the contract with --untangle-shift 0
+// (AFinishedMapShortOfTheContractTriesTheNextCandidates finishes the next candidates); with a
+// limit already spent none is finished, the first map's files are written, and the warning and
+// the report say so.
+TEST(MapCli, TimeLimitStopsFurtherTries) {
+  const std::string dir = test::temp_dir("map-time-limit");
+  const CliRun run = polycube_cli("map --untangle-shift 0 --time-limit 0.001 " + quoted(test::data_path("helmet.off")) + " -o " + quoted(dir));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("warning: --time-limit 0.001 s reached: other orientations"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("retry:"), std::string::npos) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  EXPECT_TRUE(report.at("time_limit").at("reached").get<bool>());
+  EXPECT_FALSE(report.at("alignment").contains("finished")) << "one finished map only";
+  EXPECT_GT(report.at("map").at("polycube_to_model").at("flipped").get<int>(), 0) << "the first map met the contract: pick another case";
+  EXPECT_EQ(read_polygon_soup(dir + "/polycube_on_model.obj").points.size(), read_polygon_soup(dir + "/polycube.obj").points.size());
+}
+
 // When the winner's finished map (refined, smoothed) still has flips or P's image misses 2 % of the area,
 // the search's next candidates are finished too and the best finished map is written: helmet
 // (1000 triangles) ends its winner with 2 flipped P → M triangles when the last untangling of the
