@@ -35,7 +35,7 @@ bool TimeLimit::spent(const Progress& progress) {
 void TimeLimit::warn(const Progress& progress, const std::string& what) const {
   if (!reached) return;
   std::ostringstream text;
-  text << "--time-limit " << seconds << " s reached: " << what << " not tried";
+  text << "--time-limit " << seconds << " s reached: no further try started (" << what << "); the best so far is written";
   progress.warning(text.str());
 }
 

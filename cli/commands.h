@@ -47,7 +47,7 @@ struct TimeLimit {
   bool reached = false;  // a try was left out for it
   // True, and `reached` set, when the limit is set and spent: the caller starts no further try.
   bool spent(const Progress& progress);
-  // "--time-limit S s reached: <what> not tried" as a warning (once), when reached.
+  // "--time-limit S s reached: no further try started (<what>); ..." as a warning, when reached.
   void warn(const Progress& progress, const std::string& what) const;
 };
 void add_time_limit_option(CLI::App& command, TimeLimit& limit);

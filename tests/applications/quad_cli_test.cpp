@@ -283,7 +283,7 @@ TEST(QuadCli, TimeLimitStopsFurtherTries) {
       polycube_cli("quad " + quoted(test::data_path("eight.off")) + " --target-faces 200 --refine 0 --refine-bound 0 --thin-parts 0" +
                    " --time-limit 0.001 -o " + quoted(out) + " --report " + quoted(report_path));
   ASSERT_EQ(run.code, 0) << run.err;
-  EXPECT_NE(run.err.find("warning: --time-limit 0.001 s reached: other orientations"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("warning: --time-limit 0.001 s reached: no further try started (other orientations"), std::string::npos) << run.err;
   EXPECT_EQ(run.err.find("retry:"), std::string::npos) << run.err;
   const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
   EXPECT_TRUE(report.at("time_limit").at("reached").get<bool>());

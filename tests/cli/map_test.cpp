@@ -205,7 +205,7 @@ TEST(MapCli, TimeLimitStopsFurtherTries) {
   const std::string dir = test::temp_dir("map-time-limit");
   const CliRun run = polycube_cli("map --untangle-shift 0 --time-limit 0.001 " + quoted(test::data_path("helmet.off")) + " -o " + quoted(dir));
   ASSERT_EQ(run.code, 0) << run.err;
-  EXPECT_NE(run.err.find("warning: --time-limit 0.001 s reached: other orientations"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("warning: --time-limit 0.001 s reached: no further try started (other orientations"), std::string::npos) << run.err;
   EXPECT_EQ(run.err.find("retry:"), std::string::npos) << run.err;
   const auto report = read_json(dir + "/report.json");
   EXPECT_TRUE(report.at("time_limit").at("reached").get<bool>());
