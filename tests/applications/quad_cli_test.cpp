@@ -268,10 +268,6 @@ TEST(QuadCli, QuadsStillShortTryFinerContours) {
   EXPECT_EQ(quad_topology(read_quads(dir + "/thin.obj")).genus(), 2);
 }
 
-// A coarse model (CGAL's corner tetrahedron, 4 triangles) gets its long edges split before the
-// map is built: the map's disk maps on 4 triangles shear the quads (about 29 deg mean angle
-// deviation from 90 at 1000 quads, one orientation, no refinement), on the split model they do
-// not (about 9). The quads lie on the model as read and are measured against it.
 // --time-limit: once the first try has quads, no further try starts after the limit. Eight at 200
 // quads without refinement falls short of the bound on every try (QuadsStillShortTryFinerContours
 // runs the same command without a limit and makes several tries); with a limit already spent
@@ -360,6 +356,10 @@ TEST(QuadCli, QuadsFarMoreThanAskedTryTheModelAsRead) {
   }
 }
 
+// A coarse model (CGAL's corner tetrahedron, 4 triangles) gets its long edges split before the
+// map is built: the map's disk maps on 4 triangles shear the quads (about 29 deg mean angle
+// deviation from 90 at 1000 quads, one orientation, no refinement), on the split model they do
+// not (about 9). The quads lie on the model as read and are measured against it.
 TEST(QuadCli, CoarseModelIsSplitBeforeTheMap) {
   const std::string dir = test::temp_dir("quad-split");
   const std::string base = "quad " + quoted(test::data_path("tetrahedron.off")) +
