@@ -1,10 +1,10 @@
 #include "applications/quad/quad_collapse.h"
 
 #include <algorithm>
-#include <limits>
-#include <stdexcept>
 #include <array>
+#include <limits>
 #include <set>
+#include <stdexcept>
 #include <utility>
 
 namespace polycube {
