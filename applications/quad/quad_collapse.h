@@ -21,7 +21,8 @@ namespace polycube {
 
 //   collapsed             quads removed
 //   bad_before, bad_after flipped or degenerate quads (bad_quads) before and after
-//   irregular_added       vertices made irregular (valence != 4) that were regular before
+//   irregular_added       irregular vertices (valence != 4) after minus before: the net change,
+//                         negative when a neighbour's collapse makes irregular corners regular
 struct QuadCollapseResult {
   int collapsed = 0;
   int bad_before = 0, bad_after = 0;

@@ -39,7 +39,6 @@ const PolycubeResult& eight_polycube() {
   return result;
 }
 
-
 Eigen::Vector3d on_mesh(const TriMesh& mesh, const SurfacePoint& p) {
   return p.bary[0] * mesh.V.row(mesh.F(p.face, 0)).transpose() + p.bary[1] * mesh.V.row(mesh.F(p.face, 1)).transpose() +
          p.bary[2] * mesh.V.row(mesh.F(p.face, 2)).transpose();
