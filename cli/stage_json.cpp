@@ -30,6 +30,8 @@ nlohmann::json topology_json(const TopologyResult& topology) {
   j["piece_count"] = topology.sliced.pieces.size();
   j["max_piece_genus"] = max_genus;
   j["intrinsic_flips"] = topology.harmonic.intrinsic_flips;
+  j["harmonic_factorisation"] = topology.harmonic.supernodal ? "supernodal (CHOLMOD)" : "simplicial (Eigen)";
+  j["harmonic_residual"] = topology.harmonic.residual;
   j["seconds"] = {{"harmonic", topology.seconds_harmonic},
                   {"critical_points", topology.seconds_critical},
                   {"planes", topology.seconds_planes},

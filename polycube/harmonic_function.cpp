@@ -5,12 +5,14 @@
 #include "polycube/errors.h"
 #include "polycube/mesh_topology.h"
 
+#include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -91,6 +93,40 @@ EdgeWeights laplacian_weights(const IntrinsicTriangulation& T, const HarmonicOpt
   return out;
 }
 
+// A Cholesky factorisation of a symmetric positive definite matrix given by its lower triangle:
+// Eigen's SimplicialLDLT (AMD ordering) below `supernodal_min` unknowns, CHOLMOD's supernodal
+// LLᵀ (METIS ordering, which fills a mesh Laplacian's factor less than AMD: 37.7 M against 63.2 M
+// nonzeros at 773 409 unknowns) from there on.
+class LaplacianFactor {
+ public:
+  using Matrix = Eigen::SparseMatrix<double>;
+
+  // Returns false when the factorisation fails.
+  bool compute(const Matrix& lower, int supernodal_min) {
+    if (lower.rows() >= supernodal_min) {
+      supernodal_ = std::make_unique<Eigen::CholmodSupernodalLLT<Matrix, Eigen::Lower>>();
+      cholmod_common& common = supernodal_->cholmod();
+      common.print = 0;  // failures are reported by info(), never printed
+      common.nmethods = 1;
+      common.method[0].ordering = CHOLMOD_METIS;
+      supernodal_->compute(lower);
+      return supernodal_->info() == Eigen::Success;
+    }
+    simplicial_ = std::make_unique<Eigen::SimplicialLDLT<Matrix, Eigen::Lower, Eigen::AMDOrdering<int>>>(lower);
+    return simplicial_->info() == Eigen::Success;
+  }
+
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const {
+    return supernodal_ ? Eigen::VectorXd(supernodal_->solve(b)) : Eigen::VectorXd(simplicial_->solve(b));
+  }
+
+  bool supernodal() const { return supernodal_ != nullptr; }
+
+ private:
+  std::unique_ptr<Eigen::SimplicialLDLT<Matrix, Eigen::Lower, Eigen::AMDOrdering<int>>> simplicial_;
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<Matrix, Eigen::Lower>> supernodal_;
+};
+
 }  // namespace
 
 HarmonicFunction harmonic_function(const TriMesh& mesh, const HarmonicOptions& options) {
@@ -136,8 +172,10 @@ HarmonicFunction harmonic_function(const TriMesh& mesh, const HarmonicOptions& o
   result.f = Eigen::VectorXd::Zero(nv);
   result.f[result.sink] = 1;
   if (n > 0) {
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> solver(L);
-    if (solver.info() != Eigen::Success)
+    LaplacianFactor solver;
+    const bool factored = solver.compute(L, options.supernodal_min_unknowns);
+    result.supernodal = solver.supernodal();
+    if (!factored)
       throw AlgorithmError("harmonic_function: Cholesky factorisation of the " + std::to_string(n) + " x " +
                            std::to_string(n) + " Laplacian failed");
     Eigen::VectorXd x = solver.solve(rhs);
@@ -170,7 +208,7 @@ struct HarmonicSolver::Impl {
   // triangle, and its factorisation.
   int ground = 0;
   Eigen::SparseMatrix<double> L;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> solver;
+  LaplacianFactor solver;
   mutable std::mutex mutex;
 };
 
@@ -202,8 +240,7 @@ HarmonicSolver::HarmonicSolver(const TriMesh& mesh, const HarmonicOptions& optio
   for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, diagonal[i]);
   m.L.resize(n, n);
   m.L.setFromTriplets(triplets.begin(), triplets.end());
-  m.solver.compute(m.L);
-  if (m.solver.info() != Eigen::Success)
+  if (!m.solver.compute(m.L, options.supernodal_min_unknowns))
     throw AlgorithmError("harmonic_function: Cholesky factorisation of the grounded " + std::to_string(n) + " x " +
                          std::to_string(n) + " Laplacian failed");
 }
@@ -263,6 +300,7 @@ HarmonicFunction HarmonicSolver::solve(const TriMesh& moved) const {
   result.intrinsic_flips = m.intrinsic.flips;
   result.negative_weights = m.negative_weights;
   result.raised_weights = m.raised_weights;
+  result.supernodal = m.solver.supernodal();
   return result;
 }
 

@@ -22,6 +22,12 @@ struct HarmonicOptions {
   // With intrinsic Delaunay: edge weights below this fraction of the mean edge weight are
   // raised to it (see HarmonicFunction::raised_weights).
   double min_weight = 1e-6;
+  // Laplacians with at least this many unknowns are factorised by CHOLMOD's supernodal Cholesky
+  // (SuiteSparse, METIS ordering); smaller ones by Eigen's SimplicialLDLT (AMD ordering). Both
+  // solve the same system; the supernodal one is the faster from about 10^5 unknowns (gargoyle
+  // subdivided twice, 773 409 unknowns: 47 s → 12 s; gargoyle, 48 339: 0.37 s → 0.50 s;
+  // bench/quad.md, twenty-eighth session).
+  int supernodal_min_unknowns = 100000;
 };
 
 // f and what it was computed on.
@@ -40,6 +46,7 @@ struct HarmonicOptions {
 //              free vertex lies strictly between its lowest and highest neighbour
 //   residual   max-norm of the Laplace equation's residual at the free vertices, relative to
 //              the right-hand side
+//   supernodal the Laplacian was factorised by CHOLMOD (HarmonicOptions::supernodal_min_unknowns)
 struct HarmonicFunction {
   Eigen::VectorXd f;
   int source = -1;
@@ -49,9 +56,11 @@ struct HarmonicFunction {
   int negative_weights = 0;
   int raised_weights = 0;
   double residual = 0;
+  bool supernodal = false;
 };
 
-// Solves the Dirichlet problem of eq. (1) with the cotangent Laplacian (sparse LDLT, Eigen).
+// Solves the Dirichlet problem of eq. (1) with the cotangent Laplacian (sparse Cholesky: Eigen's
+// or CHOLMOD's, see HarmonicOptions::supernodal_min_unknowns).
 // Lengths are taken after scaling the model to the unit cube (largest bounding-box side 1), so
 // f does not depend on the scale or position of the input.
 //   mesh  closed, connected, edge-manifold, consistently oriented mesh; every vertex used

@@ -62,6 +62,9 @@ TEST(MapCli, TopologyStageWritesReportAndPieces) {
   const auto& topology = report.at("topology");
   EXPECT_EQ(topology.at("critical_points").at("saddles").get<int>(), 4);
   EXPECT_EQ(topology.at("max_piece_genus").get<int>(), 0);
+  // eight.off is far below the supernodal size.
+  EXPECT_EQ(topology.at("harmonic_factorisation").get<std::string>(), "simplicial (Eigen)");
+  EXPECT_LT(topology.at("harmonic_residual").get<double>(), 1e-10);
 
   // pieces.ply is the sliced model: same genus and one face colour per piece.
   const PolygonSoup pieces = read_polygon_soup(dir + "/pieces.ply");
