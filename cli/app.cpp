@@ -39,6 +39,11 @@ void TimeLimit::warn(const Progress& progress, const std::string& what) const {
   progress.warning(text.str());
 }
 
+std::function<bool()> TimeLimit::stop_for(const Progress& progress) const {
+  if (seconds <= 0) return {};
+  return [&progress, limit = seconds]() { return progress.elapsed_seconds() >= limit; };
+}
+
 void add_time_limit_option(CLI::App& command, TimeLimit& limit) {
   command
       .add_option("--time-limit", limit.seconds,

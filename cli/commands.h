@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <functional>
 #include <string>
 
 namespace polycube::cli {
@@ -49,6 +50,10 @@ struct TimeLimit {
   bool spent(const Progress& progress);
   // "--time-limit S s reached: no further try started (<what>); ..." as a warning, when reached.
   void warn(const Progress& progress, const std::string& what) const;
+  // For a search the command can do without (it already has a result): true once the limit is
+  // spent, safe to call from any thread (AlignmentOptions::stop); empty without a limit. The
+  // caller then calls spent() to set `reached`.
+  std::function<bool()> stop_for(const Progress& progress) const;
 };
 void add_time_limit_option(CLI::App& command, TimeLimit& limit);
 

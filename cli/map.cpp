@@ -493,7 +493,10 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     if (pass.align == "auto" && pass.stage != "topology") {
       const double align_start = progress.elapsed_seconds();
       progress.stage("align", "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 2 with fewest corners (the rest if both flip), scored by flips");
-      alignment = choose_alignment(source, pass.topology, pass.polycube);
+      // A later search (there is a map already) ends where the time limit is spent.
+      AlignmentOptions align_options;
+      if (kept) align_options.stop = time_limit.stop_for(progress);
+      alignment = choose_alignment(source, pass.topology, pass.polycube, align_options);
       nlohmann::json candidates = nlohmann::json::array();
       for (const AlignmentCandidate& c : alignment.candidates)
         candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle}, {"eps_area", c.eps_area},
@@ -503,6 +506,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (alignment.proxy_faces > 0)
         progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
       align_seconds += progress.elapsed_seconds() - align_start;
+      if (alignment.stopped) {
+        progress.stage("align", "stopped: the time limit is spent");
+        time_limit.spent(progress);
+        alignment_report["stopped"] = true;
+        return;
+      }
       if (alignment.chosen < 0)  // every orientation failed, with the full budget too: say why the input frame did
         throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
       const AlignmentCandidate& chosen = alignment.candidates[alignment.chosen];

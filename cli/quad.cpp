@@ -344,8 +344,9 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   }
   // The same pipeline as `map`: orientation, topology, polycube, map, on the turned model; the
   // images are turned back into the input's frame. One search's candidates become attempts.
+  // `stop` (AlignmentOptions::stop) can end the search: then it adds none and returns false.
   const auto add_attempts = [&](const PolycubeOptions& polycube, nlohmann::json& alignment_report, std::string suffix,
-                                const QuadModel& given) {
+                                const QuadModel& given, const std::function<bool()>& stop) {
     const QuadModel* on = &given;
     const TriMesh& model = *given.mesh;
     if (given.separation) suffix += ", separated copy";
@@ -353,12 +354,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     if (options.align == "auto" || options.align == "corners") {
       AlignmentOptions align_options;
       if (options.align == "corners") align_options.mapped_candidates = 0;
+      align_options.stop = stop;
       progress.stage("align", options.align == "auto"
                                   ? "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 2 with fewest corners (the rest if both flip), scored by flips"
                                   : "orientations (input frame, principal axes, normal axes): the polycube with the fewest corners");
       const double align_start = progress.elapsed_seconds();
       alignment = choose_alignment(model, options.topology, polycube, align_options);
-      if (alignment.chosen < 0) {
+      if (!alignment.stopped && alignment.chosen < 0) {
         on->no_polycube = true;
         if (const QuadModel* copy = separated_of(*on)) {
           progress.stage("align", "no orientation gives a valid polycube: the search again on the model's separated copy");
@@ -368,6 +370,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
         }
       }
       seconds["align"] = seconds.value("align", 0.0) + progress.elapsed_seconds() - align_start;
+      if (alignment.stopped) {
+        progress.stage("align", "stopped: the time limit is spent");
+        alignment_report["stopped"] = true;
+        return false;
+      }
       if (alignment.proxy_faces > 0)
         progress.stage("align", "scored on a simplified copy of " + std::to_string(alignment.proxy_faces) + " faces");
       if (alignment.chosen < 0)
@@ -387,10 +394,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       attempts.back()->polycube_options = polycube;
       attempts.back()->on = on;
     }
+    return true;
   };
   if (options.map_dir.empty()) {
     const QuadModel* copy = options.separate == "always" ? separated_of(split_model) : nullptr;
-    add_attempts(options.polycube, report["alignment"], "", copy ? *copy : split_model);
+    add_attempts(options.polycube, report["alignment"], "", copy ? *copy : split_model, {});
   }
   // The map stages one orientation still needs, then its quads.
   bool placement_said = false;  // the copy's placement said once
@@ -500,7 +508,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     progress.stage("retry", shortfall() + "all over again " + what);
     const size_t first = attempts.size();
     try {
-      add_attempts(polycube, report["alignment"][key], suffix, on);
+      // The time limit ends the search itself too: the quads kept so far are a result.
+      if (!add_attempts(polycube, report["alignment"][key], suffix, on, time_limit.stop_for(progress))) {
+        time_limit.spent(progress);
+        return;
+      }
       remesh_from(first);
     } catch (const Error& e) {
       progress.warning(key + ": " + e.what());

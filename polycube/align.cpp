@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -177,6 +178,21 @@ std::vector<AlignedStages> Alignment::stages_in_order() const {
 Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology, const PolycubeOptions& polycube,
                            const AlignmentOptions& options) {
   Alignment out;
+  static const char* const kStopped = "not built: the search was stopped";
+  // True once the caller's stop says so (and from then on: one answer for the whole search).
+  std::atomic<bool> stopped{false};
+  const auto stopping = [&]() {
+    if (!stopped && options.stop && options.stop()) stopped = true;
+    return stopped.load();
+  };
+  // The search given up: nothing chosen, nothing built kept.
+  const auto given_up = [&]() {
+    Alignment none;
+    none.candidates = std::move(out.candidates);
+    none.proxy_faces = out.proxy_faces;
+    none.stopped = true;
+    return none;
+  };
   double spread = 1;
   const Eigen::Matrix3d pca = principal_axes(mesh, &spread);
   const bool reserve_principal = !(spread >= options.principal_axes_spread);
@@ -240,6 +256,10 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   // `budget`; a failure is recorded in the candidate (polycubes[i] null).
   auto build = [&](int i, const PolycubeOptions& budget) {
     AlignmentCandidate& c = out.candidates[i];
+    if (stopping()) {
+      c.error = kStopped;
+      return;
+    }
     const auto start = std::chrono::steady_clock::now();
     const long long work = rasterized_cells();
     try {
@@ -305,6 +325,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   auto map_candidates = [&](const std::vector<int>& which) {
     parallel_for_each(which, options.threads, "orientation", [&](int i) {
       AlignmentCandidate& c = out.candidates[i];
+      if (stopping()) return;
       const auto start = std::chrono::steady_clock::now();
       try {
         maps[i] = std::make_shared<PolycubeMap>(build_polycube_map(turned[i], *polycubes[i]));
@@ -388,6 +409,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       if (!maps[j]) polycubes[j].reset();  // a variant competes only with its map
     n = static_cast<int>(out.candidates.size());
   }
+  if (stopping()) return given_up();
   // Fewest flips, then least ε_angle, then fewest corners, then the earlier candidate.
   auto key = [&](int i) {
     const AlignmentCandidate& c = out.candidates[i];
@@ -420,6 +442,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       if (polycubes[i]) out.chosen = i;
     }
   }
+  if (stopping()) return given_up();
   if (out.chosen >= 0 && use_proxy) {
     // Scored on the coarse copy: the stages of the model itself, in the order of the scoring (the
     // fallback's choice first), with the caller's budget; the first orientation that builds wins.
@@ -430,6 +453,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     ranked.insert(ranked.begin(), out.chosen);
     out.chosen = -1;
     for (int i : ranked) {
+      if (stopping()) return given_up();
       AlignmentCandidate& c = out.candidates[i];
       const auto start = std::chrono::steady_clock::now();
       try {

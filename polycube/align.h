@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -33,6 +34,8 @@ namespace polycube {
 //            one), or as a near miss given a second chance (four times the budget)
 //   failing_slabs  when its last polycube build ran out of repair rounds (RepairRoundsExhausted):
 //            the slabs still failing; 0 otherwise
+//   error    why its stages failed ("not built: the search was stopped" when AlignmentOptions::
+//            stop ended the search first)
 //   rasterized_cells  grid cells its last polycube build's checks rasterized, passed or not
 struct AlignmentCandidate {
   std::string name;
@@ -53,6 +56,7 @@ struct AlignmentCandidate {
 //   topology, polycube, map  the winner's stages (built on the turned model), so they need not be
 //              redone (map is null when the winner was not mapped, or was scored on the proxy)
 //   proxy_faces  faces of the simplified copy the candidates were scored on (0: the model itself)
+//   stopped    AlignmentOptions::stop ended the search: nothing is chosen
 //   alternatives  other mapped candidates with their stages, next best first (see
 //              AlignmentOptions::alternatives), for a caller whose later stages (refinement,
 //              smoothing) may end with flips on the winner and who then tries the next
@@ -71,6 +75,7 @@ struct Alignment {
   std::shared_ptr<PolycubeResult> polycube;
   std::shared_ptr<PolycubeMap> map;
   int proxy_faces = 0;
+  bool stopped = false;
   std::vector<AlignedStages> alternatives;
   // The winner's stages, then the alternatives'. With no winner (nothing chosen, or no search
   // run): one entry with the identity and nothing built, for the caller to build in the input
@@ -154,6 +159,11 @@ struct AlignmentOptions {
   // proxy for the finished map's (a winner by 28 to 32 flips ended 1 / 1, the runner-up 0 / 1).
   // Never on the proxy (the alternatives would be stages of the copy).
   int alternatives = 2;
+  // Asked before each candidate's next step (its topology and polycube, its map, its stages on
+  // the model itself; steps under way finish) and between the search's phases: once it returns
+  // true, no step starts and the search returns with nothing chosen and `stopped` set (a caller's
+  // time limit, for a search whose result it can do without). Called from several threads.
+  std::function<bool()> stop;
 };
 
 // Scores the candidates (input frame / principal axes / normal axes × which axis is z); see the

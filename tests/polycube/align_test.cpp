@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <atomic>
 #include <stdexcept>
 #include <vector>
 
@@ -105,6 +106,40 @@ TEST(Align, PrincipalAxesOfACubeAreHeldInReserve) {
   EXPECT_GE(a.chosen, 0);
   options.principal_axes_spread = 1;
   EXPECT_EQ(choose_alignment(cube, TopologyOptions{}, PolycubeOptions{}, options).candidates.size(), 6u);
+}
+
+// The caller's stop ends the search: once it says so no candidate's step starts, and nothing is
+// chosen (a time limit, for a search whose result the caller can do without).
+TEST(Align, StopEndsTheSearch) {
+  const TriMesh model = load_test_mesh("knot.off");
+  AlignmentOptions options;
+  options.threads = 1;
+  options.stop = [] { return true; };
+  const Alignment none = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, options);
+  EXPECT_TRUE(none.stopped);
+  EXPECT_EQ(none.chosen, -1);
+  EXPECT_FALSE(none.polycube);
+  EXPECT_TRUE(none.alternatives.empty());
+  ASSERT_FALSE(none.candidates.empty());
+  for (const AlignmentCandidate& c : none.candidates) {
+    EXPECT_LT(c.corners, 0) << c.name;
+    EXPECT_LT(c.flipped, 0) << c.name;
+    EXPECT_EQ(c.error, "not built: the search was stopped") << c.name;
+  }
+  // Asked once per step: on one thread, a stop that says so at its third question lets exactly
+  // two candidates' polycubes be built, and no map.
+  std::atomic<int> asked{0};
+  options.stop = [&asked] { return ++asked > 2; };
+  const Alignment two = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, options);
+  EXPECT_TRUE(two.stopped);
+  EXPECT_EQ(two.chosen, -1);
+  int built = 0;
+  for (const AlignmentCandidate& c : two.candidates) {
+    built += c.error != "not built: the search was stopped";
+    EXPECT_LT(c.flipped, 0) << c.name;
+  }
+  EXPECT_EQ(built, 2);
+  EXPECT_GT(two.candidates.size(), 2u);
 }
 
 // Nothing passes a scoring budget of one round and no inserted plane (rotor needs several rounds
