@@ -27,8 +27,10 @@ double Progress::elapsed_seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
+bool TimeLimit::over(const Progress& progress) const { return seconds > 0 && progress.elapsed_seconds() >= seconds; }
+
 bool TimeLimit::spent(const Progress& progress) {
-  if (seconds > 0 && progress.elapsed_seconds() >= seconds) reached = true;
+  if (over(progress)) reached = true;
   return reached;
 }
 
@@ -41,7 +43,7 @@ void TimeLimit::warn(const Progress& progress, const std::string& what) const {
 
 std::function<bool()> TimeLimit::stop_for(const Progress& progress) const {
   if (seconds <= 0) return {};
-  return [&progress, limit = seconds]() { return progress.elapsed_seconds() >= limit; };
+  return [&progress, limit = *this]() { return limit.over(progress); };
 }
 
 void add_time_limit_option(CLI::App& command, TimeLimit& limit) {

@@ -48,6 +48,8 @@ struct TimeLimit {
   bool reached = false;  // a try was left out for it
   // True, and `reached` set, when the limit is set and spent: the caller starts no further try.
   bool spent(const Progress& progress);
+  // Whether the limit is set and spent (reached is not touched).
+  bool over(const Progress& progress) const;
   // "--time-limit S s reached: no further try started (<what>); ..." as a warning, when reached.
   void warn(const Progress& progress, const std::string& what) const;
   // For a search the command can do without (it already has a result): true once the limit is

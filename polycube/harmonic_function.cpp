@@ -109,8 +109,12 @@ class LaplacianFactor {
       common.print = 0;  // failures are reported by info(), never printed
       common.nmethods = 1;
       common.method[0].ordering = CHOLMOD_METIS;
-      supernodal_->compute(lower);
-      return supernodal_->info() == Eigen::Success;
+      // Eigen's wrapper factorises whatever the analysis left: when that failed (out of memory)
+      // there is no factor, so the status is checked between the two.
+      supernodal_->analyzePattern(lower);
+      if (common.status < CHOLMOD_OK) return false;
+      supernodal_->factorize(lower);
+      return common.status >= CHOLMOD_OK && supernodal_->info() == Eigen::Success;
     }
     simplicial_ = std::make_unique<Eigen::SimplicialLDLT<Matrix, Eigen::Lower, Eigen::AMDOrdering<int>>>(lower);
     return simplicial_->info() == Eigen::Success;
