@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+
 namespace polycube {
 
 struct TriangleClosest {
@@ -37,6 +39,22 @@ inline TriangleClosest closest_on_triangle(const Eigen::Vector3d& p, const Eigen
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
     const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
     return {b + w * (c - b), {0, 1 - w, w}};
+  }
+  if (!(va + vb + vc > 0)) {
+    // A degenerate triangle (its corners on a line) that p projects inside: the nearest of its
+    // sides.
+    const auto on_side = [&p](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+      const Eigen::Vector3d e = v - u;
+      const double length = e.squaredNorm();
+      return length > 0 ? std::clamp((p - u).dot(e) / length, 0.0, 1.0) : 0.0;
+    };
+    const double t_ab = on_side(a, b), t_bc = on_side(b, c), t_ca = on_side(c, a);
+    TriangleClosest best{a + t_ab * ab, {1 - t_ab, t_ab, 0}};
+    const TriangleClosest from_bc{b + t_bc * (c - b), {0, 1 - t_bc, t_bc}};
+    const TriangleClosest from_ca{c + t_ca * (a - c), {t_ca, 0, 1 - t_ca}};
+    if ((from_bc.point - p).squaredNorm() < (best.point - p).squaredNorm()) best = from_bc;
+    if ((from_ca.point - p).squaredNorm() < (best.point - p).squaredNorm()) best = from_ca;
+    return best;
   }
   const double denom = 1 / (va + vb + vc);
   const double v = vb * denom, w = vc * denom;

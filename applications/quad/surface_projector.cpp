@@ -3,6 +3,7 @@
 #include "polycube/closest_point.h"
 #include "polycube/mesh_topology.h"
 #include "polycube/parallel.h"
+#include "polycube/triangle_tree.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -44,7 +45,7 @@ class FacePrimitive {
   const std::vector<Triangle>* triangles_ = nullptr;
 };
 
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, FacePrimitive>>;
+using Tree = CGAL::AABB_tree<triangle_tree::ClosestPointTraits<FacePrimitive>>;
 
 }  // namespace
 

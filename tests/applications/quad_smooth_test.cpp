@@ -5,6 +5,7 @@
 #include "applications/quad/quad_remesh.h"
 #include "applications/quad/quad_smooth.h"
 
+#include "polycube/closest_point.h"
 #include "polycube/polycube_build.h"
 #include "polycube/polycube_map.h"
 #include "polycube/topology.h"
@@ -12,7 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -409,6 +412,15 @@ TEST(SurfaceProjector, SearchFromAHintFindsWhatTheTreeFinds) {
     const Eigen::Vector3d offset(std::sin(1.3 * v), std::cos(0.7 * v), std::sin(2.1 * v + 2));
     const Eigen::Vector3d query = p + 2e-2 * diagonal * offset.normalized();
     const SurfaceHit tree = projector.closest(query);
+    // The tree's answer is the nearest of all faces (brute force).
+    double brute = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < model.num_faces(); ++f)
+      brute = std::min(brute, (closest_on_triangle(query, model.V.row(model.F(f, 0)), model.V.row(model.F(f, 1)),
+                                                   model.V.row(model.F(f, 2)))
+                                   .point -
+                               query)
+                                  .norm());
+    EXPECT_NEAR(tree.distance, brute, 1e-12 * diagonal) << "vertex " << v;
     for (const SurfaceHit& hint : {at, far_away}) {
       const SurfaceHit hinted = projector.closest(query, hint);
       EXPECT_NEAR(hinted.distance, tree.distance, 1e-12 * diagonal) << "vertex " << v;
