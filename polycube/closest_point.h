@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 
@@ -17,6 +18,23 @@ struct TriangleClosest {
 inline TriangleClosest closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                            const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  if (ab.cross(ac).squaredNorm() == 0) {
+    // A degenerate triangle (corners on a line, or equal): the nearest point of its sides (the
+    // regions below assume an area; with two equal corners they divided 0 by 0 or took the
+    // wrong side).
+    const auto on_side = [&p](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+      const Eigen::Vector3d e = v - u;
+      const double length = e.squaredNorm();
+      return length > 0 ? std::clamp((p - u).dot(e) / length, 0.0, 1.0) : 0.0;
+    };
+    const double t_ab = on_side(a, b), t_bc = on_side(b, c), t_ca = on_side(c, a);
+    TriangleClosest best{a + t_ab * ab, {1 - t_ab, t_ab, 0}};
+    const TriangleClosest from_bc{b + t_bc * (c - b), {0, 1 - t_bc, t_bc}};
+    const TriangleClosest from_ca{c + t_ca * (a - c), {t_ca, 0, 1 - t_ca}};
+    if ((from_bc.point - p).squaredNorm() < (best.point - p).squaredNorm()) best = from_bc;
+    if ((from_ca.point - p).squaredNorm() < (best.point - p).squaredNorm()) best = from_ca;
+    return best;
+  }
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return {a, {1, 0, 0}};
   const Eigen::Vector3d bp = p - b;
@@ -39,22 +57,6 @@ inline TriangleClosest closest_on_triangle(const Eigen::Vector3d& p, const Eigen
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
     const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
     return {b + w * (c - b), {0, 1 - w, w}};
-  }
-  if (!(va + vb + vc > 0)) {
-    // A degenerate triangle (its corners on a line) that p projects inside: the nearest of its
-    // sides.
-    const auto on_side = [&p](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
-      const Eigen::Vector3d e = v - u;
-      const double length = e.squaredNorm();
-      return length > 0 ? std::clamp((p - u).dot(e) / length, 0.0, 1.0) : 0.0;
-    };
-    const double t_ab = on_side(a, b), t_bc = on_side(b, c), t_ca = on_side(c, a);
-    TriangleClosest best{a + t_ab * ab, {1 - t_ab, t_ab, 0}};
-    const TriangleClosest from_bc{b + t_bc * (c - b), {0, 1 - t_bc, t_bc}};
-    const TriangleClosest from_ca{c + t_ca * (a - c), {t_ca, 0, 1 - t_ca}};
-    if ((from_bc.point - p).squaredNorm() < (best.point - p).squaredNorm()) best = from_bc;
-    if ((from_ca.point - p).squaredNorm() < (best.point - p).squaredNorm()) best = from_ca;
-    return best;
   }
   const double denom = 1 / (va + vb + vc);
   const double v = vb * denom, w = vc * denom;

@@ -28,15 +28,17 @@ Eigen::Vector3d on_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& u, c
 }
 
 TEST(ClosestPoint, DegenerateTriangleGivesTheNearestPointOfItsSides) {
-  // Corners on one line (c between a and b), and the same with two corners equal: every query
-  // gets a finite point of the segment, as near as the segment's own closest point.
+  // Corners on one line (c between a and b), two corners equal (each pair in turn: equal a and b
+  // once divided 0 by 0), and all three equal: every query gets a finite point of the segment (or
+  // the point), as near as the segment's own closest point.
   const Eigen::Vector3d a(0, 0, 0), b(2, 0, 0), c(0.5, 0, 0);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> coordinate(-1, 3);
   for (int k = 0; k < 200; ++k) {
     const Eigen::Vector3d p(coordinate(random), coordinate(random), coordinate(random));
-    for (const auto& [x, y, z] : {std::array<Eigen::Vector3d, 3>{a, b, c}, std::array<Eigen::Vector3d, 3>{c, a, b},
-                                  std::array<Eigen::Vector3d, 3>{a, b, b}}) {
+    for (const auto& [x, y, z] :
+         {std::array<Eigen::Vector3d, 3>{a, b, c}, std::array<Eigen::Vector3d, 3>{c, a, b}, std::array<Eigen::Vector3d, 3>{a, b, b},
+          std::array<Eigen::Vector3d, 3>{a, a, b}, std::array<Eigen::Vector3d, 3>{a, b, a}, std::array<Eigen::Vector3d, 3>{b, a, a}}) {
       const TriangleClosest found = closest_on_triangle(p, x, y, z);
       ASSERT_TRUE(found.point.allFinite() && found.bary.allFinite()) << "query " << k;
       EXPECT_NEAR((found.point - p).norm(), (on_segment(p, a, b) - p).norm(), 1e-12) << "query " << k;
@@ -44,6 +46,8 @@ TEST(ClosestPoint, DegenerateTriangleGivesTheNearestPointOfItsSides) {
       EXPECT_NEAR(found.bary.sum(), 1, 1e-12);
       EXPECT_GE(found.bary.minCoeff(), 0);
     }
+    const TriangleClosest point = closest_on_triangle(p, c, c, c);
+    EXPECT_EQ(point.point, c);
   }
 }
 
