@@ -5,10 +5,6 @@
 #include "polycube/parallel.h"
 #include "polycube/triangle_tree.h"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/Simple_cartesian.h>
-
 #include <boost/iterator/counting_iterator.hpp>
 
 #include <Eigen/Geometry>
@@ -22,9 +18,9 @@ namespace polycube {
 
 namespace {
 
-using Kernel = CGAL::Simple_cartesian<double>;
-using Point = Kernel::Point_3;
-using Triangle = Kernel::Triangle_3;
+using triangle_tree::Kernel;
+using triangle_tree::Point;
+using triangle_tree::Triangle;
 
 // A triangle of the surface known by its face index.
 class FacePrimitive {
