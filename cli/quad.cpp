@@ -2,6 +2,7 @@
 // map (issue 7): a conforming grid on P carried to M, irregular only at P's corners.
 #include "cli/commands.h"
 #include "cli/mesh_input.h"
+#include "cli/quad_choice.h"
 
 #include "applications/preview/render.h"
 #include "applications/quad/quad_remesh.h"
@@ -216,7 +217,7 @@ struct QuadAttempt : AlignedStages {
   int bad() const { return result->quality.flipped_quads + result->quality.degenerate_quads; }
   bool too_far() const { return result->quality.hausdorff_measured && result->quality.hausdorff_percent > kHausdorffWarnPercent; }
   bool more_than(double most) const { return most > 0 && result->quality.quads > most; }
-  std::tuple<int, int, int, double> rank(double most) const {
+  QuadTryRank rank(double most) const {
     return {bad(), too_far() ? 1 : 0, more_than(most) ? 1 : 0, result->quality.hausdorff_percent};
   }
   bool worth_retrying() const {
@@ -565,6 +566,29 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   }
   time_limit.warn(progress, "other orientations, finer contours and thin parts");
   if (time_limit.seconds > 0) report["time_limit"] = {{"seconds", time_limit.seconds}, {"reached", time_limit.reached}};
+  // Valid quads before few quads (quad_choice.h): when the kept try still has flipped or
+  // degenerate quads, a capped try that had fewer is taken even though it made more quads than
+  // asked (gyroid: its uncapped first try, 47 981 quads, kept 1 flipped quad; its thin-parts try,
+  // 36 588 quads, none, and was left out for its size).
+  {
+    std::vector<QuadAttempt*> finished;
+    std::vector<QuadTryRank> ranks;
+    size_t kept_index = 0;
+    for (const std::unique_ptr<QuadAttempt>& a : attempts) {
+      if (!a->result) continue;
+      if (a.get() == kept) kept_index = finished.size();
+      finished.push_back(a.get());
+      ranks.push_back(a->rank(most_quads));
+    }
+    QuadAttempt* valid = finished[prefer_fewer_bad_quads(ranks, kept_index)];
+    if (valid != kept) {
+      progress.stage("retry", "kept " + valid->name + " though it has " + std::to_string(valid->result->quality.quads) +
+                                  " quads: " + std::to_string(valid->bad()) + " flipped or degenerate against " +
+                                  std::to_string(kept->bad()));
+      kept = valid;
+      report["alignment"]["kept_oversized"] = true;
+    }
+  }
   {
     // The kept try's corners mended (the other tries are only compared).
     QuadRemeshOptions mend = remesh;
