@@ -457,6 +457,15 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
 
   const std::filesystem::path dir(options.output_dir);
   std::error_code ec;
+  // A run that fails before writing anything leaves no directory it made behind.
+  struct RemoveIfLeftEmpty {
+    std::filesystem::path path;
+    bool created = false;
+    ~RemoveIfLeftEmpty() {
+      std::error_code ec;
+      if (created && std::filesystem::is_empty(path, ec) && !ec) std::filesystem::remove(path, ec);
+    }
+  } made{dir, !std::filesystem::exists(dir, ec)};
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))
     throw OutputError("cannot create output directory " + options.output_dir + (ec ? ": " + ec.message() : ""));

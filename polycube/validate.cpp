@@ -349,6 +349,16 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
     }
   }
 
+  // Every face of zero area (all vertices at one place, or on a line) is removed above.
+  if (d.faces == 0) d.problems.push_back("no faces of non-zero area");
+  // Squared areas and lengths must stay normal doubles (a coordinate of 1e300: the diagonal is
+  // infinite and every later stage divides by it).
+  if (d.faces > 0 && !(d.bbox.diagonal() >= kSmallestDiagonal && d.bbox.diagonal() <= kLargestDiagonal)) {
+    std::ostringstream size;
+    size << "bounding-box diagonal " << d.bbox.diagonal() << " is outside " << kSmallestDiagonal << " .. " << kLargestDiagonal
+         << " (scale the model)";
+    d.problems.push_back(size.str());
+  }
   if (d.nonmanifold_edges > 0)
     d.problems.push_back(plural(d.nonmanifold_edges, "non-manifold edge") + " (more than two faces on an edge)");
   if (d.nonmanifold_vertices > 0)

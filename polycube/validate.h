@@ -11,6 +11,9 @@
 
 namespace polycube {
 
+// The model's size the stages compute with: squared areas (about diagonal^4) stay normal doubles.
+inline constexpr double kSmallestDiagonal = 1e-50, kLargestDiagonal = 1e50;
+
 struct PrepareOptions {
   // Close every boundary loop with CGAL's hole filling (triangulate and refine, no fairing).
   bool fill_holes = false;

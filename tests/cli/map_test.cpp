@@ -463,6 +463,23 @@ TEST(MapCli, BadInputFailsCleanlyAndWritesNothing) {
   EXPECT_EQ(test::line_count(run.err), 1) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir)) << "nothing is written for an unmappable mesh";
 
+  // Faces of zero area only (four corners at one point), and a corner at 1e300: refused at the
+  // gate (before, the first went on to an empty mesh and `quad` stopped on an internal error).
+  const std::string one_point = test::write_file(test::temp_dir("map-bad") + "/one-point.off",
+                                                 "OFF\n4 4 0\n1 1 1\n1 1 1\n1 1 1\n1 1 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n");
+  const std::string far = test::write_file(test::temp_dir("map-bad") + "/far.off",
+                                           "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n1e300 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n");
+  for (const std::string& input : {one_point, far}) {
+    run = polycube_cli("map --quiet " + quoted(input) + " -o " + quoted(dir));
+    EXPECT_EQ(run.code, 4) << input << ": " << run.err;
+    EXPECT_EQ(test::line_count(run.err), 1) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(dir));
+    run = polycube_cli("quad --quiet " + quoted(input) + " -o " + quoted(dir + ".obj"));
+    EXPECT_EQ(run.code, 4) << input << ": " << run.err;
+    EXPECT_EQ(test::line_count(run.err), 1) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(dir + ".obj"));
+  }
+
   run = polycube_cli("map --quiet " + quoted(test::data_path("sphere.off")) + " -o /proc/polycube-cannot-write");
   EXPECT_EQ(run.code, 5) << run.err;
   EXPECT_EQ(test::line_count(run.err), 1) << run.err;

@@ -235,6 +235,39 @@ TEST(Validate, NonFiniteCoordinatesAndBadIndicesThrowInputError) {
   EXPECT_THROW(prepare_mesh(bad_index), InputError);
 }
 
+// Faces that all have zero area are all removed: nothing is left to map (before, the empty mesh
+// passed as valid and the topology stage failed on it).
+TEST(Validate, OnlyZeroAreaFacesIsNotMappable) {
+  PolygonSoup one_point = tetrahedron();
+  for (Eigen::Vector3d& p : one_point.points) p = Eigen::Vector3d(0.5, 0.25, 2);
+  PolygonSoup on_a_line = tetrahedron();
+  for (int i = 0; i < 4; ++i) on_a_line.points[i] = Eigen::Vector3d(i, 2.0 * i, 0);
+  for (const PolygonSoup& soup : {one_point, on_a_line}) {
+    const PreparedMesh prepared = prepare_mesh(soup);
+    EXPECT_FALSE(prepared.diagnosis.valid());
+    EXPECT_THROW(require_mappable(prepared.diagnosis), MeshError);
+  }
+}
+
+// A model so large or so small that its squared areas leave the doubles is refused with its size;
+// within the range it is valid.
+TEST(Validate, ModelsBeyondTheDoublesRangeAreNotMappable) {
+  const auto scaled = [](double scale, double dx = 0) {
+    PolygonSoup soup = tetrahedron(dx);
+    for (Eigen::Vector3d& p : soup.points) p *= scale;
+    return prepare_mesh(soup).diagnosis;
+  };
+  for (double scale : {1e300, 1e-60}) {
+    const MeshDiagnosis d = scaled(scale);
+    ASSERT_FALSE(d.valid()) << scale;
+    EXPECT_NE(d.problems.back().find("bounding-box diagonal"), std::string::npos) << d.problems.back();
+  }
+  PolygonSoup one_far = tetrahedron();
+  one_far.points[3].z() = 1e300;
+  EXPECT_FALSE(prepare_mesh(one_far).diagnosis.valid());
+  for (double scale : {1e-40, 1e-3, 1e3, 1e40}) EXPECT_TRUE(scaled(scale).valid()) << scale;
+}
+
 TEST(Validate, EmptySoupIsNotMappable) {
   const PreparedMesh prepared = prepare_mesh(PolygonSoup{});
   EXPECT_FALSE(prepared.diagnosis.valid());
