@@ -1,6 +1,7 @@
 // Closed meshes of implicit surfaces, made by CGAL's surface mesher: shapes no one tuned polycube
 // on (springs with tight coils, a thin sheet, plates with 4 and 16 holes, crossed rings, a
-// gyroid ball of genus 8, two spheres almost touching). Built and run by
+// gyroid ball of genus 8, two spheres almost touching; since the thirtieth session also a torus
+// knot, linked rings, a rounded and a drilled cube, spikes, tentacles, a thin bowl). Built and run by
 // bench/make_implicit_meshes.sh; the results are in bench/unseen.md.
 //
 // Usage: implicit_meshes NAME SIZE OUT.off
@@ -155,6 +156,87 @@ std::map<std::string, Shape> shapes() {
                    return std::max(g - 0.5, std::sqrt(x * x + y * y + z * z) - 1.6);
                  },
                  {0, 0, 0}, 2};
+  // Second batch (2026-12-06, thirtieth session).
+  // A (2, 5) torus knot, tube radius 0.22 (genus 1, knotted).
+  static const std::vector<Vec> knot25 = [] {
+    std::vector<Vec> line;
+    for (int i = 0; i <= 1000; ++i) {
+      const double t = 2 * M_PI * i / 1000, r = 2 + std::cos(5 * t);
+      line.push_back({r * std::cos(2 * t), r * std::sin(2 * t), -std::sin(5 * t)});
+    }
+    return line;
+  }();
+  s["knot25"] = {[](double x, double y, double z) { return polyline_distance(knot25, {x, y, z}) - 0.22; }, knot25[0], 7};
+  // A superquadric cube |x|^10 + |y|^10 + |z|^10 = 1: flat faces, rounded edges (CAD-like).
+  s["roundcube"] = {[](double x, double y, double z) {
+                      return std::pow(std::pow(x, 10) + std::pow(y, 10) + std::pow(z, 10), 0.1) - 1;
+                    },
+                    {0, 0, 0}, 2.5};
+  // The same cube drilled through along each axis by a square tunnel (genus 5).
+  s["drilledcube"] = {[](double x, double y, double z) {
+                        const double box = std::pow(std::pow(x, 10) + std::pow(y, 10) + std::pow(z, 10), 0.1) - 1;
+                        const auto tunnel = [](double a, double b) { return std::pow(std::pow(a / 0.4, 8) + std::pow(b / 0.4, 8), 1.0 / 8) - 1; };
+                        return std::max(box, -0.4 * std::min({tunnel(x, y), tunnel(y, z), tunnel(z, x)}));
+                      },
+                      {0.7, 0.7, 0.7}, 3.5};
+  // A ball with 14 thin spikes (to the cube's corners and faces), tapering to their tips.
+  s["spiky"] = {[](double x, double y, double z) {
+                  double d = std::sqrt(x * x + y * y + z * z) - 0.7;
+                  std::vector<Vec> tips;
+                  for (int i = -1; i <= 1; i += 2)
+                    for (int j = -1; j <= 1; j += 2)
+                      for (int k = -1; k <= 1; k += 2) tips.push_back({0.95 * i, 0.95 * j, 0.95 * k});
+                  for (int a = 0; a < 3; ++a)
+                    for (int sign = -1; sign <= 1; sign += 2) {
+                      Vec t{0, 0, 0};
+                      t[a] = 1.65 * sign;
+                      tips.push_back(t);
+                    }
+                  for (const Vec& t : tips) {
+                    const double len = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+                    const double u = std::clamp((x * t[0] + y * t[1] + z * t[2]) / (len * len), 0.0, 1.0);
+                    d = smooth_min(d, segment_distance({x, y, z}, {0, 0, 0}, t) - (0.16 - 0.13 * u), 0.1);
+                  }
+                  return d;
+                },
+                {0, 0, 0}, 2.5};
+  // A body with 6 thin curling tentacles (tube radius 0.07).
+  static const std::vector<std::vector<Vec>> tentacles = [] {
+    std::vector<std::vector<Vec>> all;
+    for (int k = 0; k < 6; ++k) {
+      std::vector<Vec> line;
+      const double a = 2 * M_PI * k / 6;
+      for (int i = 0; i <= 120; ++i) {
+        const double t = i / 120.0, r = 0.5 + 1.6 * t, swirl = a + 1.2 * t * t;
+        line.push_back({r * std::cos(swirl), r * std::sin(swirl), -0.3 - 0.8 * t + 0.6 * t * t * std::sin(3 * t + k)});
+      }
+      all.push_back(line);
+    }
+    return all;
+  }();
+  s["octopus"] = {[](double x, double y, double z) {
+                    double d = std::sqrt(x * x + y * y + (z - 0.2) * (z - 0.2) / 1.6) - 0.7;
+                    for (const auto& line : tentacles) d = smooth_min(d, polyline_distance(line, {x, y, z}) - 0.07, 0.08);
+                    return d;
+                  },
+                  {0, 0, 0}, 3};
+  // A hemispherical bowl 0.08 thick with a rounded rim (genus 0, two close sheets).
+  s["bowl"] = {[](double x, double y, double z) {
+                 const double r = std::sqrt(x * x + y * y + z * z);
+                 const double shell = std::fabs(r - 1) - 0.04;
+                 if (z <= 0) return shell;
+                 const double q = std::sqrt(x * x + y * y) - 1;  // past the rim: distance to the rim circle
+                 return std::sqrt(q * q + z * z) - 0.04;
+               },
+               {0, 0, -1}, 2};
+  // Two linked rings joined by a bridge (genus 2, the handles linked).
+  s["linked"] = {[](double x, double y, double z) {
+                   const double q = std::sqrt(x * x + y * y) - 1, a = std::sqrt(q * q + z * z) - 0.2;
+                   const double r = std::sqrt((x - 1) * (x - 1) + z * z) - 1, b = std::sqrt(r * r + y * y) - 0.2;
+                   const double bridge = segment_distance({x, y, z}, {-1, 0, 0}, {0, 0, 0}) - 0.12;
+                   return smooth_min(std::min(a, b), bridge, 0.1);
+                 },
+                 {-1, 0, 0}, 4};
   return s;
 }
 
