@@ -676,7 +676,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   }
   const std::string polycube_path = (dir / "polycube.obj").string();
   if (polycube && !map) {
-    write_mesh(polycube_path, mesh_to_input(polycube->polycube.mesh));
+    write_mesh(polycube_path, placed_as_input(prepared, mesh_to_input(polycube->polycube.mesh)));
     outputs.push_back(polycube_path);
   }
   if (map) {
@@ -726,7 +726,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       untangle_images(prepared.mesh, written, options.untangle_shift, options.untangle_shift_max, progress);
       report["written"] = {{"untangling", written.untangling}};
     }
-    write_mesh(polycube_path, P_input.mesh);
+    write_mesh(polycube_path, placed_as_input(prepared, P_input.mesh));
     outputs.push_back(polycube_path);
     const MapAudit& audit = written.audit;
     report["map"] = {{"contours", map->contours},
@@ -755,12 +755,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     TriMesh on_model = P.mesh;
     on_model.V = written.on_model_xyz;
     const std::string on_model_path = (dir / "polycube_on_model.obj").string();
-    write_mesh(on_model_path, on_model);
+    write_mesh(on_model_path, placed_as_input(prepared, on_model));
     outputs.push_back(on_model_path);
     TriMesh on_polycube = prepared.mesh;
     on_polycube.V = written.on_polycube_xyz;
     const std::string on_polycube_path = (dir / "model_on_polycube.obj").string();
-    write_mesh(on_polycube_path, on_polycube);
+    write_mesh(on_polycube_path, placed_as_input(prepared, on_polycube));
     outputs.push_back(on_polycube_path);
     progress.stage("map", std::to_string(flipped_disks) + " flipped disk triangles; " + std::to_string(audit.polycube_to_model.flipped) + " / " +
                               std::to_string(audit.model_to_polycube.flipped) + " flipped image triangles (P to M / M to P), eps_angle " +
@@ -772,7 +772,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
 
   const std::string pieces_path = (dir / "pieces.ply").string();
   SlicedMesh pieces_in_input = *model_pieces;
-  pieces_in_input.mesh.V = to_input(model_pieces->mesh.V);
+  pieces_in_input.mesh.V = placed_as_input(prepared, to_input(model_pieces->mesh.V));
   write_pieces(pieces_path, pieces_in_input);
   outputs.push_back(pieces_path);
   const std::string preview_path = (dir / "preview.png").string();

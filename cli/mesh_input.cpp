@@ -39,6 +39,18 @@ std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, con
   return s;
 }
 
+Eigen::MatrixX3d placed_as_input(const PreparedMesh& prepared, Eigen::MatrixX3d V) {
+  if (!prepared.offset.isZero(0)) V.rowwise() += prepared.offset.transpose();
+  return V;
+}
+
+TriMesh placed_as_input(const PreparedMesh& prepared, TriMesh mesh) {
+  mesh.V = placed_as_input(prepared, std::move(mesh.V));
+  return mesh;
+}
+
+Eigen::Vector3d placed_as_input(const PreparedMesh& prepared, const Eigen::Vector3d& x) { return x + prepared.offset; }
+
 nlohmann::json diagnosis_json(const PreparedMesh& prepared) {
   const MeshDiagnosis& d = prepared.diagnosis;
   nlohmann::json j;

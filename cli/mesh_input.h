@@ -28,6 +28,12 @@ PreparedMesh load_mesh(const MeshInput& input, const Progress& progress);
 // otherwise. Results on the copy go back to the model with to_original_surface.
 std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report);
 
+// Positions of the prepared mesh's frame in the input's: plus PreparedMesh::offset (a model far
+// from the origin is moved there by prepare_mesh; every file and coordinate written goes back).
+Eigen::MatrixX3d placed_as_input(const PreparedMesh& prepared, Eigen::MatrixX3d V);
+TriMesh placed_as_input(const PreparedMesh& prepared, TriMesh mesh);
+Eigen::Vector3d placed_as_input(const PreparedMesh& prepared, const Eigen::Vector3d& x);
+
 // The diagnosis as a JSON object (keys documented in README.md).
 nlohmann::json diagnosis_json(const PreparedMesh& prepared);
 

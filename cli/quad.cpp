@@ -120,12 +120,15 @@ struct MapFromDirectory {
 };
 
 MapFromDirectory read_map_directory(const std::string& dir, const std::shared_ptr<const SurfaceProjector>& model,
-                                    const Progress& progress) {
+                                    const Eigen::Vector3d& offset, const Progress& progress) {
   const std::filesystem::path d(dir);
   if (!std::filesystem::is_directory(d)) throw InputError(dir + ": not a directory");
   MapFromDirectory map;
   map.polycube = read_triangles((d / "polycube.obj").string());
-  const TriMesh on_model = read_triangles((d / "polycube_on_model.obj").string());
+  TriMesh on_model = read_triangles((d / "polycube_on_model.obj").string());
+  // The files are in the input's frame; the model may have been moved to the origin.
+  map.polycube.V.rowwise() -= offset.transpose();
+  on_model.V.rowwise() -= offset.transpose();
   if (on_model.V.rows() != map.polycube.V.rows() || on_model.F != map.polycube.F)
     throw InputError(dir + ": polycube_on_model.obj (" + std::to_string(on_model.V.rows()) +
                      " vertices) does not have polycube.obj's triangles (" + std::to_string(map.polycube.V.rows()) +
@@ -145,7 +148,9 @@ MapFromDirectory read_map_directory(const std::string& dir, const std::shared_pt
   return map;
 }
 
-nlohmann::json quality_json(const QuadQuality& q) {
+// Positions (the farthest points) plus offset: in the input's frame (PreparedMesh::offset).
+nlohmann::json quality_json(const QuadQuality& q, const Eigen::Vector3d& offset) {
+  const Eigen::Vector3d on_quads = q.farthest_on_quads + offset, on_model = q.farthest_on_model + offset;
   return {{"quads", q.quads},
           {"vertices", q.vertices},
           {"edges", q.topology.edges},
@@ -167,8 +172,8 @@ nlohmann::json quality_json(const QuadQuality& q) {
           {"hausdorff_sides",
            q.hausdorff_measured ? nlohmann::json{{"quads_to_model", q.quads_to_model},
                                                  {"model_to_quads", q.model_to_quads},
-                                                 {"farthest_on_quads", {q.farthest_on_quads.x(), q.farthest_on_quads.y(), q.farthest_on_quads.z()}},
-                                                 {"farthest_on_model", {q.farthest_on_model.x(), q.farthest_on_model.y(), q.farthest_on_model.z()}},
+                                                 {"farthest_on_quads", {on_quads.x(), on_quads.y(), on_quads.z()}},
+                                                 {"farthest_on_model", {on_model.x(), on_model.y(), on_model.z()}},
                                                  {"mean", q.mean_distance}}
                                 : nlohmann::json()},
           {"diagonal", q.diagonal}};
@@ -329,7 +334,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   if (!options.map_dir.empty()) {
     progress.stage("map", "reading " + options.map_dir);
     const std::shared_ptr<const SurfaceProjector> projector = as_read.projector();
-    from_directory = read_map_directory(options.map_dir, projector, progress);
+    from_directory = read_map_directory(options.map_dir, projector, prepared.offset, progress);
     auto a = std::make_unique<QuadAttempt>();
     a->name = options.map_dir;
     a->on = &as_read;
@@ -644,13 +649,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                     std::to_string(result.grid.corners.size()) + " corners), one quad each at least"
               : ""));
   if (q.hausdorff_measured && q.hausdorff_percent > kHausdorffWarnPercent) {
-    const Eigen::Vector3d& at = q.model_to_quads >= q.quads_to_model ? q.farthest_on_model : q.farthest_on_quads;
+    const Eigen::Vector3d at = placed_as_input(prepared, q.model_to_quads >= q.quads_to_model ? q.farthest_on_model : q.farthest_on_quads);
     warn("the quads are up to " + percent(q.hausdorff_percent) + " % of the bounding-box diagonal from the model (" +
          (q.model_to_quads >= q.quads_to_model ? "a part of the model the quads miss" : "quads off the model") +
          ", near " + percent(at.x()) + " " + percent(at.y()) + " " + percent(at.z()) + ")");
   }
 
-  write_polygon_mesh(options.output, result.mesh.V, quad_polygons(result.mesh));
+  write_polygon_mesh(options.output, placed_as_input(prepared, result.mesh.V), quad_polygons(result.mesh));
   seconds["grid"] = result.seconds_grid;
   seconds["carry"] = result.seconds_carry;
   seconds["refine"] = result.seconds_refine;
@@ -712,13 +717,14 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                                   {"sharp_after", q.sharp_corners},
                                   {"tries", result.mending_tries},
                                   {"kept", result.mending_kept}};
-    report["quality"] = quality_json(q);
+    report["quality"] = quality_json(q, prepared.offset);
     // Where the flipped and degenerate quads are (the first 20), to find them in a viewer.
     nlohmann::json bad = nlohmann::json::array();
     for (int b : bad_quads(result.mesh, *kept->on->placement().projector(), remesh.quality)) {
       if (bad.size() == 20) break;
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
       for (int k = 0; k < 4; ++k) centre += result.mesh.V.row(result.mesh.Q(b, k)).transpose() / 4;
+      centre = placed_as_input(prepared, centre);
       bad.push_back({{"quad", b}, {"centre", {centre.x(), centre.y(), centre.z()}}});
     }
     report["quality"]["bad_quads"] = bad;

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <queue>
 #include <set>
 #include <sstream>
@@ -281,6 +282,21 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   mesh.F = to_matrix(triangles);
   if (const int removed = remove_unreferenced_vertices(mesh); removed > 0)
     result.repairs.push_back("removed " + plural(removed, "unreferenced vertex"));
+  // Far from the origin, moved there before anything adds up products of positions (the outward
+  // orientation's signed volume, the stages' contour areas). Within the box, each coordinate
+  // minus the centre's is exact.
+  if (mesh.num_vertices() > 0 && options.centre_beyond_diagonals > 0) {
+    const BoundingBox box = bounding_box(mesh.V);
+    const Eigen::Vector3d centre = (box.min + box.max) / 2;
+    if (std::isfinite(box.diagonal()) && centre.norm() > options.centre_beyond_diagonals * box.diagonal()) {
+      result.offset = centre;
+      mesh.V.rowwise() -= centre.transpose();
+      std::ostringstream moved;
+      moved << "moved the model to the origin (its centre lies " << std::setprecision(3) << centre.norm() / box.diagonal()
+            << " diagonals away); outputs are moved back";
+      result.repairs.push_back(moved.str());
+    }
+  }
 
   if (mesh.num_faces() == 0) {
     d.problems.push_back("no faces");
@@ -338,6 +354,8 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   d.degenerate_faces = count_collinear_faces(mesh);
   d.euler = d.vertices - d.edges + d.faces;
   d.bbox = bounding_box(mesh.V);
+  d.bbox.min += result.offset;  // the input's
+  d.bbox.max += result.offset;
 
   if (d.manifold() && d.orientable) {
     d.genus = genus(mesh.F, mesh.num_vertices());

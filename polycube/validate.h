@@ -21,6 +21,10 @@ struct PrepareOptions {
   bool largest_component = false;
   // Search for pairs of intersecting faces (CGAL, about a second per million faces).
   bool check_self_intersections = true;
+  // A model whose bounding box's centre is farther from the origin than this many diagonals is
+  // moved there (PreparedMesh::offset): at 1e7 from the origin, a sphere 0.5 in radius built no
+  // polycube (a contour's shoelace area of absolute coordinates came out negative). 0: never.
+  double centre_beyond_diagonals = 1000;
 };
 
 // What the prepared mesh is, counted after the repairs of prepare_mesh.
@@ -58,6 +62,9 @@ struct PreparedMesh {
   MeshDiagnosis diagnosis;
   // One line per change made to the input (triangulation, removals, reorientation, repairs).
   std::vector<std::string> repairs;
+  // The input's positions are mesh's plus this: zero unless the model was moved to the origin
+  // (PrepareOptions::centre_beyond_diagonals). The diagnosis' bounding box stays the input's.
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
 };
 
 // Triangulates polygons, removes repeated-vertex and duplicate faces and unreferenced vertices,

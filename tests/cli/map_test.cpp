@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -454,6 +455,67 @@ TEST(MapCli, QuietRunPrintsNothing) {
   EXPECT_EQ(run.code, 0) << run.err;
   EXPECT_EQ(run.err, "");
   EXPECT_EQ(run.out, "");
+}
+
+// sphere.off (radius 0.5) moved to (1e7, -3e6, 5e6): before, no orientation gave a polycube (a
+// contour's area of absolute coordinates came out negative). The model is now moved to the origin
+// for the stages and every file goes back: the map meets its contract with its images round the
+// far centre, and `quad`, with and without that map, writes quads there too.
+TEST(MapCli, AModelFarFromTheOriginIsMappedInPlace) {
+  const std::string dir = test::temp_dir("map-far");
+  const Eigen::Vector3d far(1e7, -3e6, 5e6);
+  std::ostringstream off;
+  off.precision(17);
+  const TriMesh sphere = test::load_test_mesh("sphere.off");
+  off << "OFF\n" << sphere.num_vertices() << " " << sphere.num_faces() << " 0\n";
+  for (int v = 0; v < sphere.num_vertices(); ++v) {
+    const Eigen::Vector3d x = sphere.V.row(v).transpose() + far;
+    off << x.x() << " " << x.y() << " " << x.z() << "\n";
+  }
+  for (int f = 0; f < sphere.num_faces(); ++f) off << "3 " << sphere.F(f, 0) << " " << sphere.F(f, 1) << " " << sphere.F(f, 2) << "\n";
+  const std::string input = test::write_file(dir + "/far-sphere.off", off.str());
+  const std::string out = dir + "/map";
+  CliRun run = polycube_cli("map " + quoted(input) + " -o " + quoted(out));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("moved the model to the origin"), std::string::npos) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(out + "/report.json"));
+  EXPECT_TRUE(report["map"]["meets_contract"].get<bool>());
+  EXPECT_NEAR(report["input"]["bounding_box"]["min"][0].get<double>(), 1e7 - 0.5, 1e-6);
+  // The smallest and largest distance of a file's vertices from the far centre (read as written:
+  // prepare_mesh would move them to the origin).
+  const auto radii = [&](const std::string& path) {
+    Eigen::Vector2d r(INFINITY, 0);
+    for (const Eigen::Vector3d& x : read_polygon_soup(path).points) {
+      const double d = (x - far).norm();
+      r = Eigen::Vector2d(std::min(r[0], d), std::max(r[1], d));
+    }
+    return r;
+  };
+  // On the sphere's triangles: between their inscribed radius and the largest vertex's, 0.50003.
+  const double outer = 0.5001;
+  const Eigen::Vector2d on_model = radii(out + "/polycube_on_model.obj");
+  EXPECT_GT(on_model[0], 0.45);
+  EXPECT_LT(on_model[1], outer);
+  const Eigen::Vector2d polycube = radii(out + "/polycube.obj");
+  const Eigen::Vector2d on_polycube = radii(out + "/model_on_polycube.obj");
+  for (const Eigen::Vector2d& r : {polycube, on_polycube}) {
+    EXPECT_GT(r[0], 0.2);
+    EXPECT_LT(r[1], 1.0);
+  }
+  for (const std::string& map_option : {std::string(), " --map " + quoted(out)}) {
+    const std::string quads = dir + "/quads.obj";
+    run = polycube_cli("quad --quiet " + quoted(input) + " -o " + quoted(quads) + " --target-faces 2000" + map_option +
+                       " --report " + quoted(dir + "/quads.json"));
+    ASSERT_EQ(run.code, 0) << map_option << ": " << run.err;
+    const Eigen::Vector2d r = radii(quads);
+    EXPECT_GT(r[0], 0.45) << map_option;
+    EXPECT_LT(r[1], outer) << map_option;
+    const nlohmann::json q = nlohmann::json::parse(test::read_file(dir + "/quads.json"))["quality"];
+    EXPECT_EQ(q["flipped_quads"].get<int>(), 0) << map_option;
+    EXPECT_LT(q["hausdorff_percent_diagonal"].get<double>(), 0.5) << map_option;
+    const nlohmann::json& at = q["hausdorff_sides"]["farthest_on_model"];
+    EXPECT_LT((Eigen::Vector3d(at[0].get<double>(), at[1].get<double>(), at[2].get<double>()) - far).norm(), outer) << map_option;
+  }
 }
 
 TEST(MapCli, BadInputFailsCleanlyAndWritesNothing) {

@@ -268,6 +268,32 @@ TEST(Validate, ModelsBeyondTheDoublesRangeAreNotMappable) {
   for (double scale : {1e-40, 1e-3, 1e3, 1e40}) EXPECT_TRUE(scaled(scale).valid()) << scale;
 }
 
+// A model far from the origin (beyond centre_beyond_diagonals of its size) is moved there, exactly,
+// with the offset recorded and the diagnosis' box the input's; one nearer stays where it is.
+TEST(Validate, AModelFarFromTheOriginIsMovedThere) {
+  const Eigen::Vector3d far(1e7, -3e6, 5e6);
+  PolygonSoup soup = tetrahedron();
+  for (Eigen::Vector3d& p : soup.points) p += far;
+  const PreparedMesh moved = prepare_mesh(soup);
+  ASSERT_TRUE(moved.diagnosis.valid());
+  const Eigen::Vector3d centre = far + Eigen::Vector3d(0.5, 0.5, 0.5);
+  EXPECT_EQ(moved.offset, centre);
+  EXPECT_EQ(moved.repairs.back().find("moved the model to the origin"), 0u) << moved.repairs.back();
+  const PreparedMesh near = prepare_mesh(tetrahedron());
+  ASSERT_EQ(near.mesh.num_vertices(), moved.mesh.num_vertices());
+  for (int v = 0; v < near.mesh.num_vertices(); ++v)
+    EXPECT_EQ((near.mesh.V.row(v).transpose() - Eigen::Vector3d(0.5, 0.5, 0.5)).eval(), moved.mesh.V.row(v).transpose()) << v;
+  EXPECT_EQ(near.mesh.F, moved.mesh.F) << "the same faces, oriented the same way";
+  EXPECT_EQ(moved.diagnosis.bbox.min, far);
+  EXPECT_EQ(moved.diagnosis.bbox.max, (far + Eigen::Vector3d::Ones()).eval());
+  EXPECT_TRUE(near.offset.isZero(0));
+  PolygonSoup at_100 = tetrahedron(100);
+  EXPECT_TRUE(prepare_mesh(at_100).offset.isZero(0)) << "100 diagonals away is not far";
+  PrepareOptions never;
+  never.centre_beyond_diagonals = 0;
+  EXPECT_TRUE(prepare_mesh(soup, never).offset.isZero(0));
+}
+
 TEST(Validate, EmptySoupIsNotMappable) {
   const PreparedMesh prepared = prepare_mesh(PolygonSoup{});
   EXPECT_FALSE(prepared.diagnosis.valid());
