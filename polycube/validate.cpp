@@ -283,8 +283,9 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   if (const int removed = remove_unreferenced_vertices(mesh); removed > 0)
     result.repairs.push_back("removed " + plural(removed, "unreferenced vertex"));
   // Far from the origin, moved there before anything adds up products of positions (the outward
-  // orientation's signed volume, the stages' contour areas). Within the box, each coordinate
-  // minus the centre's is exact.
+  // orientation's signed volume, the stages' contour areas). Along an axis on which the model is
+  // far, each coordinate is within a factor 2 of the centre's, so the difference is exact
+  // (Sterbenz); along the others it is rounded once.
   if (mesh.num_vertices() > 0 && options.centre_beyond_diagonals > 0) {
     const BoundingBox box = bounding_box(mesh.V);
     const Eigen::Vector3d centre = (box.min + box.max) / 2;
