@@ -542,6 +542,23 @@ TEST(MapCli, BadInputFailsCleanlyAndWritesNothing) {
     EXPECT_FALSE(std::filesystem::exists(dir + ".obj"));
   }
 
+  // A mesh that passes the gate but builds no polycube (sphere.off flattened to 1e-6 of its
+  // height): exit 6, and the output directory the run made is gone again (before, it was left
+  // empty).
+  {
+    const TriMesh sphere = test::load_test_mesh("sphere.off");
+    std::ostringstream flat;
+    flat.precision(17);
+    flat << "OFF\n" << sphere.num_vertices() << " " << sphere.num_faces() << " 0\n";
+    for (int v = 0; v < sphere.num_vertices(); ++v) flat << sphere.V(v, 0) << " " << sphere.V(v, 1) << " " << 1e-6 * sphere.V(v, 2) << "\n";
+    for (int f = 0; f < sphere.num_faces(); ++f) flat << "3 " << sphere.F(f, 0) << " " << sphere.F(f, 1) << " " << sphere.F(f, 2) << "\n";
+    const std::string input = test::write_file(test::temp_dir("map-bad") + "/flat.off", flat.str());
+    run = polycube_cli("map --quiet " + quoted(input) + " -o " + quoted(dir));
+    EXPECT_EQ(run.code, 6) << run.err;
+    EXPECT_EQ(test::line_count(run.err), 1) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(dir)) << "the directory made for a run that failed is removed";
+  }
+
   run = polycube_cli("map --quiet " + quoted(test::data_path("sphere.off")) + " -o /proc/polycube-cannot-write");
   EXPECT_EQ(run.code, 5) << run.err;
   EXPECT_EQ(test::line_count(run.err), 1) << run.err;
