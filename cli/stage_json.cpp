@@ -12,6 +12,7 @@ nlohmann::json topology_json(const TopologyResult& topology) {
   j["cutting_planes"] = topology.planes_z;
   j["cutting_planes_normalised"] = topology.planes_normalised;
   j["planes_initial"] = topology.initial_planes.z.size();
+  j["planes_girth"] = topology.initial_planes.girth_planes;
   j["planes_added_for_genus"] = topology.planes_added_for_genus;
   j["split_saddles"] = topology.split_saddles;
   j["nudged_planes"] = topology.sliced.nudged_planes;

@@ -299,7 +299,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   larger.max_inserted_planes = std::min(polycube.max_inserted_planes, 4 * scoring.max_inserted_planes);
   larger.max_plane_cells = std::min(polycube.max_plane_cells, 4 * scoring.max_plane_cells);
   larger.max_repair_level = std::min(polycube.max_repair_level, scoring.max_repair_level + 3);
-  larger.max_rasterized_cells = cap(polycube.max_rasterized_cells, 4 * options.max_rasterized_cells);
+  larger.max_rasterized_cells = cap(polycube.max_rasterized_cells, options.max_fallback_rasterized_cells);
   auto build_fallback = [&](int i, const PolycubeOptions& budget) {
     out.candidates[i].error.clear();
     build(i, budget);

@@ -123,6 +123,12 @@ struct AlignmentOptions {
   // 1.9e8); the checks rasterize 1–2e7 cells a second;
   // cheese turned off its axes spent 229–1 445 s per input-frame candidate.
   double max_rasterized_cells = 5e8;
+  // The same for the builds with four times the scoring budget (full_budget_fallback,
+  // near_miss_slabs): their rounds, planes and cells are four times the scoring's, their
+  // rasterized cells are not. Those that passed needed at most 1.9e8 (above); cow's separated
+  // copy turned to its least-spread principal axis spent 108 s on 2.0e9 cells and failed all the
+  // same (bench/map.md, thirty-first session). 0: no limit.
+  double max_fallback_rasterized_cells = 5e8;
   // How many candidates (fewest corners first) get their map built and audited first; if all of
   // those still have flipped triangles, the rest are mapped too. 0: corners only.
   int mapped_candidates = 2;

@@ -461,6 +461,43 @@ TEST(MapCli, QuietRunPrintsNothing) {
 // contour's area of absolute coordinates came out negative). The model is now moved to the origin
 // for the stages and every file goes back: the map meets its contract with its images round the
 // far centre, and `quad`, with and without that map, writes quads there too.
+// A CAD-style rod 1000 times as long as it is wide (24 sides, one sliver pair per side along the
+// whole length, fan caps). At d_z alone its pieces were 13 times as long as their contours, the
+// disk maps crowded, and the map did not finish in 15 minutes; the girth rule's planes make it
+// meet the contract, and quads from that map are valid.
+TEST(MapCli, AThinRodMeetsTheContract) {
+  const std::string dir = test::temp_dir("map-rod");
+  const int n = 24;
+  std::ostringstream off;
+  off.precision(17);
+  off << "OFF\n" << 2 * n + 2 << " " << 4 * n << " 0\n";
+  for (int end = 0; end < 2; ++end)
+    for (int i = 0; i < n; ++i)
+      off << 0.001 * std::cos(2 * M_PI * i / n) << " " << 0.001 * std::sin(2 * M_PI * i / n) << " " << end << "\n";
+  off << "0 0 0\n0 0 1\n";
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    off << "3 " << i << " " << j << " " << n + j << "\n3 " << i << " " << n + j << " " << n + i << "\n";
+    off << "3 " << 2 * n << " " << j << " " << i << "\n3 " << 2 * n + 1 << " " << n + i << " " << n + j << "\n";
+  }
+  const std::string input = test::write_file(dir + "/rod.off", off.str());
+  const std::string out = dir + "/map";
+  CliRun run = polycube_cli("map --quiet " + quoted(input) + " -o " + quoted(out));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(out + "/report.json"));
+  EXPECT_TRUE(report["map"]["meets_contract"].get<bool>());
+  EXPECT_GT(report["topology"]["planes_girth"].get<int>(), 100);
+  const std::string quads = dir + "/quads.obj";
+  run = polycube_cli("quad --quiet " + quoted(input) + " --map " + quoted(out) + " -o " + quoted(quads) +
+                     " --target-faces 2000 --report " + quoted(dir + "/quads.json"));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const nlohmann::json quality = nlohmann::json::parse(test::read_file(dir + "/quads.json"))["quality"];
+  EXPECT_EQ(quality["flipped_quads"].get<int>(), 0);
+  EXPECT_EQ(quality["degenerate_quads"].get<int>(), 0);
+  EXPECT_EQ(quality["genus"].get<int>(), 0);
+  EXPECT_LT(quality["hausdorff_percent_diagonal"].get<double>(), 0.5);
+}
+
 TEST(MapCli, AModelFarFromTheOriginIsMappedInPlace) {
   const std::string dir = test::temp_dir("map-far");
   const Eigen::Vector3d far(1e7, -3e6, 5e6);

@@ -174,12 +174,13 @@ TEST(Align, FallsBackToALargerBudget) {
 }
 
 // The checks' work is part of the scoring budget: with room for almost none, every candidate
-// fails under it (and under four times it) with the budget named and its work reported, and the
+// fails under it (and under the fallback's) with the budget named and its work reported, and the
 // caller's full budget, which has no such limit, still gives a polycube.
 TEST(Align, ChecksWorkIsPartOfTheScoringBudget) {
   const TriMesh model = load_test_mesh("sphere.off");
   AlignmentOptions options;
   options.max_rasterized_cells = 1;
+  options.max_fallback_rasterized_cells = 4;
   options.mapped_candidates = 0;
   const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, options);
   ASSERT_GE(a.chosen, 0);
@@ -192,6 +193,30 @@ TEST(Align, ChecksWorkIsPartOfTheScoringBudget) {
     }
   }
   EXPECT_TRUE(a.candidates[a.chosen].fallback_budget);
+}
+
+// The fallback's cells are budgeted on their own, not as four times the scoring's: with room for
+// almost none in the scoring and the default in the fallback, every candidate passes in the
+// fallback (all of them are built there at once), each with more cells than four times the
+// scoring's budget. (Were the fallback's cells four times the scoring's, all would fail there
+// and only the first to pass the caller's full budget, built one at a time, would have corners.)
+TEST(Align, TheFallbackHasItsOwnCellBudget) {
+  const TriMesh model = load_test_mesh("sphere.off");
+  AlignmentOptions options;
+  options.max_rasterized_cells = 1;
+  options.mapped_candidates = 0;
+  const Alignment a = choose_alignment(model, TopologyOptions{}, PolycubeOptions{}, options);
+  ASSERT_GE(a.chosen, 0);
+  ASSERT_TRUE(a.polycube);
+  int passed = 0;
+  for (const AlignmentCandidate& c : a.candidates) {
+    if (c.corners < 0) continue;
+    ++passed;
+    EXPECT_TRUE(c.fallback_budget) << c.name;
+    EXPECT_GT(c.rasterized_cells, 4) << c.name;
+    EXPECT_LE(static_cast<double>(c.rasterized_cells), options.max_fallback_rasterized_cells) << c.name;
+  }
+  EXPECT_GE(passed, 2);
 }
 
 // A model above the proxy threshold is scored on a simplified copy (same genus); the winner's

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -64,7 +65,7 @@ void expect_valid_planes(const TriMesh& mesh, const CriticalPoints& c, const Cut
     const bool separated = std::any_of(planes.z.begin(), planes.z.end(), [&](double p) { return p > z[k] && p < z[k + 1]; });
     EXPECT_TRUE(separated) << "no plane between critical heights " << z[k] << " and " << z[k + 1];
   }
-  EXPECT_EQ(static_cast<int>(planes.z.size()), planes.level_planes + planes.spacing_planes);
+  EXPECT_EQ(static_cast<int>(planes.z.size()), planes.level_planes + planes.spacing_planes + planes.girth_planes);
 }
 
 TEST(CuttingPlanes, SeparateCriticalLevelsAndRespectDz) {
@@ -129,6 +130,82 @@ TEST(CuttingPlanes, NormalisedPlanesUnchangedUnderScalingAndTranslation) {
   }
 }
 
+// A closed rod along z: n vertices round each end circle, one quad (two triangles) per side along
+// the whole length, the ends closed by fans round a centre vertex (as CAD models are meshed).
+TriMesh make_rod(double radius, double length, int n) {
+  TriMesh rod;
+  rod.V.resize(2 * n + 2, 3);
+  for (int end = 0; end < 2; ++end)
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * M_PI * i / n;
+      rod.V.row(end * n + i) << radius * std::cos(a), radius * std::sin(a), end * length;
+    }
+  rod.V.row(2 * n) << 0, 0, 0;
+  rod.V.row(2 * n + 1) << 0, 0, length;
+  rod.F.resize(4 * n, 3);
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    rod.F.row(4 * i) << i, j, n + j;
+    rod.F.row(4 * i + 1) << i, n + j, n + i;
+    rod.F.row(4 * i + 2) << 2 * n, j, i;
+    rod.F.row(4 * i + 3) << 2 * n + 1, n + i, n + j;
+  }
+  return rod;
+}
+
+// The contour of a tube's level set is the polygon of its rings (the crossings lie on the chords
+// between ring vertices); a plane beside the mesh meets nothing.
+TEST(CuttingPlanes, LongestContourOfATubeIsItsPolygon) {
+  const int n = 32;
+  const TriMesh tube = test::make_tube(0.5, 2, n, 8);
+  const double perimeter = 2 * n * 0.5 * std::sin(M_PI / n);
+  const std::vector<double> lengths = longest_contours(tube, {-1, 0.3, 1.1, 3});
+  ASSERT_EQ(lengths.size(), 4u);
+  EXPECT_EQ(lengths[0], 0);
+  EXPECT_NEAR(lengths[1], perimeter, 1e-12);
+  EXPECT_NEAR(lengths[2], perimeter, 1e-12);
+  EXPECT_EQ(lengths[3], 0);
+  // Two tubes side by side: the longer contour counts.
+  TriMesh both = tube;
+  const TriMesh thin = test::make_tube(0.1, 2, n, 8);
+  both.V.resize(tube.V.rows() + thin.V.rows(), 3);
+  both.V << tube.V, thin.V.rowwise() + Eigen::RowVector3d(3, 0, 0);
+  both.F.resize(tube.F.rows() + thin.F.rows(), 3);
+  both.F << tube.F, thin.F.array() + static_cast<int>(tube.V.rows());
+  EXPECT_NEAR(longest_contours(both, {0.7})[0], perimeter, 1e-12);
+}
+
+// A rod 1000 times as long as it is wide gets planes along its length until no gap is longer
+// than girth_ratio times the section's contour; a thick one, or the rule turned off, gets none.
+TEST(CuttingPlanes, AThinRodGetsPlanesAlongItsLength) {
+  const TriMesh rod = make_rod(0.001, 1, 24);
+  const CriticalPoints c = harmonic_critical_points(rod);
+  const CuttingPlaneOptions options;
+  const CuttingPlanes planes = cutting_planes(rod, c, options);
+  EXPECT_GT(planes.girth_planes, 100);
+  EXPECT_EQ(static_cast<int>(planes.z.size()), planes.level_planes + planes.spacing_planes + planes.girth_planes);
+  const std::vector<double> lengths = longest_contours(rod, planes.z);
+  std::vector<double> bounds = {0};
+  bounds.insert(bounds.end(), planes.z.begin(), planes.z.end());
+  bounds.push_back(1);
+  for (size_t k = 0; k + 1 < bounds.size(); ++k) {
+    const double girth = std::max(k > 0 ? lengths[k - 1] : 0.0, k < planes.z.size() ? lengths[k] : 0.0);
+    EXPECT_LE(bounds[k + 1] - bounds[k], options.girth_ratio * girth) << "gap " << k;
+  }
+  for (int v = 0; v < rod.num_vertices(); ++v)
+    for (double z : planes.z) ASSERT_NE(rod.V(v, 2), z);
+
+  CuttingPlaneOptions off;
+  off.girth_ratio = 0;
+  const CuttingPlanes without = cutting_planes(rod, c, off);
+  EXPECT_EQ(without.girth_planes, 0);
+  EXPECT_EQ(without.z.size(), static_cast<size_t>(without.level_planes + without.spacing_planes));
+  EXPECT_LT(without.z.size(), 20u);
+
+  const TriMesh thick = make_rod(0.2, 1, 24);
+  EXPECT_EQ(cutting_planes(thick, harmonic_critical_points(thick), options).girth_planes, 0);
+}
+
 TEST(CuttingPlanes, RejectsBadOptions) {
   const TriMesh sphere = test::make_sphere(1);
   const CriticalPoints c = harmonic_critical_points(sphere);
@@ -137,6 +214,12 @@ TEST(CuttingPlanes, RejectsBadOptions) {
   EXPECT_THROW(cutting_planes(sphere, c, options), std::invalid_argument);
   options.dz = 0.08;
   options.level_merge = -1;
+  EXPECT_THROW(cutting_planes(sphere, c, options), std::invalid_argument);
+  options.level_merge = 0.01;
+  options.girth_ratio = -1;
+  EXPECT_THROW(cutting_planes(sphere, c, options), std::invalid_argument);
+  options.girth_ratio = 4;
+  options.girth_spacing = 0;
   EXPECT_THROW(cutting_planes(sphere, c, options), std::invalid_argument);
   TriMesh flat = sphere;
   flat.V.col(2).setZero();
