@@ -140,16 +140,19 @@ CuttingPlanes cutting_planes(const TriMesh& mesh, const CriticalPoints& critical
       const double girth = std::max(g > 0 ? longest[g - 1] : 0.0, g < n ? longest[g] : 0.0);
       const double gap = hi - lo;
       if (!(girth > 0) || !(gap > options.girth_ratio * girth)) continue;
-      const int room = options.girth_max_planes - result.girth_planes - static_cast<int>(added.size());
-      const int extra = std::min(room, static_cast<int>(std::ceil(gap / (options.girth_spacing * girth))) - 1);
+      // Capped in doubles first: a contour of a hair's length asks for more planes than an int.
+      const double room = options.girth_max_planes - result.girth_planes - static_cast<double>(added.size());
+      const int extra = static_cast<int>(std::min(room, std::ceil(gap / (options.girth_spacing * girth)) - 1));
       const double step = gap / (extra + 1);
       for (int k = 1; k <= extra; ++k) added.push_back(place_plane(heights, lo + k * step, lo, hi, 0.25 * step));
     }
     if (added.empty()) break;
-    result.girth_planes += static_cast<int>(added.size());
+    const size_t before = planes.size();
     planes.insert(planes.end(), added.begin(), added.end());
     std::sort(planes.begin(), planes.end());
     planes.erase(std::unique(planes.begin(), planes.end()), planes.end());
+    result.girth_planes += static_cast<int>(planes.size() - before);  // distinct new heights
+    if (planes.size() == before) break;
   }
   result.z = planes;
   for (double z : planes) result.z_normalised.push_back((z - z_min) / extent);

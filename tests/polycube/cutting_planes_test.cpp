@@ -204,6 +204,15 @@ TEST(CuttingPlanes, AThinRodGetsPlanesAlongItsLength) {
 
   const TriMesh thick = make_rod(0.2, 1, 24);
   EXPECT_EQ(cutting_planes(thick, harmonic_critical_points(thick), options).girth_planes, 0);
+
+  // A rod of a hair's width asks for more planes than an int holds: capped, all distinct.
+  CuttingPlaneOptions capped;
+  capped.girth_max_planes = 50;
+  const TriMesh hair = make_rod(1e-200, 1, 8);
+  const CuttingPlanes few = cutting_planes(hair, CriticalPoints{}, capped);
+  EXPECT_GT(few.girth_planes, 0);
+  EXPECT_LE(few.girth_planes, 50);
+  EXPECT_EQ(static_cast<int>(few.z.size()), few.level_planes + few.spacing_planes + few.girth_planes);
 }
 
 TEST(CuttingPlanes, RejectsBadOptions) {
