@@ -88,6 +88,10 @@ constexpr double kRetryHausdorffPercent = 0.5;
 // quad size, 127 000 and 4.8 deg in 81 s (the orientation search's maps on them); pyramid and
 // fandisk within 0.4 deg and 0.05 % of the diagonal either way.
 constexpr long long kSplitEdgesMaxFaces = 100'000;
+// A model with more than this share of its area in triangles kSliverAspect times as long as high
+// is not split (worth_splitting in run_quad).
+constexpr double kSliverAspect = 50;
+constexpr double kSliverShareNoSplit = 0.5;
 
 std::string percent(double x) {
   char text[32];
@@ -248,8 +252,20 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   const auto split_cell = [&options](const TriMesh& mesh) {
     return options.cell_size > 0 ? options.cell_size : std::sqrt(surface_area(mesh) / options.target_faces);
   };
+  // Not a model made of slivers (most of its area in triangles 50 times as long as high: a CAD
+  // rod's sides): the splits keep their shape, and on such rods the split model's tries flipped
+  // quads and missed by up to 0.98 %, 107–155 s each, where the model as read gave valid quads in
+  // 4–31 s (bench/quad.md, thirty-first session). No benchmarked mesh has over 6 % of its area so.
+  double sliver_share = 0;
+  const auto worth_splitting = [&](const TriMesh& mesh) {
+    const double share = sliver_share = sliver_area_share(mesh, kSliverAspect);
+    if (share <= kSliverShareNoSplit) return true;
+    progress.stage("split", "not split: " + std::to_string(static_cast<int>(std::lround(100 * share))) +
+                                " % of the area is in sliver triangles, which splitting keeps");
+    return false;
+  };
   SplitLongEdges split;
-  if (options.map_dir.empty() && options.split_edges > 0) {
+  if (options.map_dir.empty() && options.split_edges > 0 && worth_splitting(prepared.mesh)) {
     split = split_long_edges(prepared.mesh, options.split_edges * split_cell(prepared.mesh), kSplitEdgesMaxFaces);
     if (split.rounds > 0)
       progress.stage("split", std::to_string(split.rounds) + " rounds of long edges split: " + std::to_string(split.mesh.num_faces()) +
@@ -308,7 +324,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   if (options.map_dir.empty()) {
     report["split"] = {{"rounds", split.rounds},
                        {"triangles", split_model.mesh->num_faces()},
-                       {"capped", split.capped}};
+                       {"capped", split.capped},
+                       {"sliver_area_share", sliver_share}};
     seconds["split"] = split_seconds;
   }
 

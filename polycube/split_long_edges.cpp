@@ -2,6 +2,9 @@
 
 #include "polycube/mesh_topology.h"
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -86,6 +89,20 @@ SplitLongEdges split_long_edges(const TriMesh& mesh, double max_length, long lon
     ++out.rounds;
   }
   return out;
+}
+
+double sliver_area_share(const TriMesh& mesh, double aspect) {
+  if (!(aspect > 0)) throw std::invalid_argument("sliver_area_share: aspect must be > 0, got " + std::to_string(aspect));
+  double total = 0, slivers = 0;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    total += area;
+    // height onto the longest edge = 2 area / longest; longest > aspect * height
+    if (longest * longest > aspect * 2 * area) slivers += area;
+  }
+  return total > 0 ? slivers / total : 0;
 }
 
 }  // namespace polycube

@@ -34,4 +34,10 @@ struct SplitLongEdges {
 // midpoint. Throws std::invalid_argument for max_length <= 0 or max_faces < 1.
 SplitLongEdges split_long_edges(const TriMesh& mesh, double max_length, long long max_faces);
 
+// The share of the surface area (0..1) in triangles whose longest edge is more than `aspect` times
+// their height onto it. The splits above keep a sliver's shape (a red split makes four similar
+// triangles), so a model made of slivers gains nothing from them but more slivers. 0 for a mesh
+// without area. Throws std::invalid_argument for aspect <= 0.
+double sliver_area_share(const TriMesh& mesh, double aspect);
+
 }  // namespace polycube

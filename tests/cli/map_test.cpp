@@ -3,6 +3,7 @@
 #include "formats/mesh_io.h"
 #include "polycube/map_audit.h"
 #include "polycube/validate.h"
+#include "support/generated_meshes.h"
 #include "support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -457,30 +458,14 @@ TEST(MapCli, QuietRunPrintsNothing) {
   EXPECT_EQ(run.out, "");
 }
 
-// sphere.off (radius 0.5) moved to (1e7, -3e6, 5e6): before, no orientation gave a polycube (a
-// contour's area of absolute coordinates came out negative). The model is now moved to the origin
-// for the stages and every file goes back: the map meets its contract with its images round the
-// far centre, and `quad`, with and without that map, writes quads there too.
 // A CAD-style rod 1000 times as long as it is wide (24 sides, one sliver pair per side along the
 // whole length, fan caps). At d_z alone its pieces were 13 times as long as their contours, the
 // disk maps crowded, and the map did not finish in 15 minutes; the girth rule's planes make it
 // meet the contract, and quads from that map are valid.
 TEST(MapCli, AThinRodMeetsTheContract) {
   const std::string dir = test::temp_dir("map-rod");
-  const int n = 24;
-  std::ostringstream off;
-  off.precision(17);
-  off << "OFF\n" << 2 * n + 2 << " " << 4 * n << " 0\n";
-  for (int end = 0; end < 2; ++end)
-    for (int i = 0; i < n; ++i)
-      off << 0.001 * std::cos(2 * M_PI * i / n) << " " << 0.001 * std::sin(2 * M_PI * i / n) << " " << end << "\n";
-  off << "0 0 0\n0 0 1\n";
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    off << "3 " << i << " " << j << " " << n + j << "\n3 " << i << " " << n + j << " " << n + i << "\n";
-    off << "3 " << 2 * n << " " << j << " " << i << "\n3 " << 2 * n + 1 << " " << n + i << " " << n + j << "\n";
-  }
-  const std::string input = test::write_file(dir + "/rod.off", off.str());
+  const std::string input = dir + "/rod.off";
+  write_mesh(input, test::make_rod(0.001, 1, 24));
   const std::string out = dir + "/map";
   CliRun run = polycube_cli("map --quiet " + quoted(input) + " -o " + quoted(out));
   ASSERT_EQ(run.code, 0) << run.err;
@@ -498,6 +483,10 @@ TEST(MapCli, AThinRodMeetsTheContract) {
   EXPECT_LT(quality["hausdorff_percent_diagonal"].get<double>(), 0.5);
 }
 
+// sphere.off (radius 0.5) moved to (1e7, -3e6, 5e6): before, no orientation gave a polycube (a
+// contour's area of absolute coordinates came out negative). The model is now moved to the origin
+// for the stages and every file goes back: the map meets its contract with its images round the
+// far centre, and `quad`, with and without that map, writes quads there too.
 TEST(MapCli, AModelFarFromTheOriginIsMappedInPlace) {
   const std::string dir = test::temp_dir("map-far");
   const Eigen::Vector3d far(1e7, -3e6, 5e6);

@@ -130,29 +130,6 @@ TEST(CuttingPlanes, NormalisedPlanesUnchangedUnderScalingAndTranslation) {
   }
 }
 
-// A closed rod along z: n vertices round each end circle, one quad (two triangles) per side along
-// the whole length, the ends closed by fans round a centre vertex (as CAD models are meshed).
-TriMesh make_rod(double radius, double length, int n) {
-  TriMesh rod;
-  rod.V.resize(2 * n + 2, 3);
-  for (int end = 0; end < 2; ++end)
-    for (int i = 0; i < n; ++i) {
-      const double a = 2 * M_PI * i / n;
-      rod.V.row(end * n + i) << radius * std::cos(a), radius * std::sin(a), end * length;
-    }
-  rod.V.row(2 * n) << 0, 0, 0;
-  rod.V.row(2 * n + 1) << 0, 0, length;
-  rod.F.resize(4 * n, 3);
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    rod.F.row(4 * i) << i, j, n + j;
-    rod.F.row(4 * i + 1) << i, n + j, n + i;
-    rod.F.row(4 * i + 2) << 2 * n, j, i;
-    rod.F.row(4 * i + 3) << 2 * n + 1, n + i, n + j;
-  }
-  return rod;
-}
-
 // The contour of a tube's level set is the polygon of its rings (the crossings lie on the chords
 // between ring vertices); a plane beside the mesh meets nothing.
 TEST(CuttingPlanes, LongestContourOfATubeIsItsPolygon) {
@@ -178,7 +155,7 @@ TEST(CuttingPlanes, LongestContourOfATubeIsItsPolygon) {
 // A rod 1000 times as long as it is wide gets planes along its length until no gap is longer
 // than girth_ratio times the section's contour; a thick one, or the rule turned off, gets none.
 TEST(CuttingPlanes, AThinRodGetsPlanesAlongItsLength) {
-  const TriMesh rod = make_rod(0.001, 1, 24);
+  const TriMesh rod = test::make_rod(0.001, 1, 24);
   const CriticalPoints c = harmonic_critical_points(rod);
   const CuttingPlaneOptions options;
   const CuttingPlanes planes = cutting_planes(rod, c, options);
@@ -202,13 +179,13 @@ TEST(CuttingPlanes, AThinRodGetsPlanesAlongItsLength) {
   EXPECT_EQ(without.z.size(), static_cast<size_t>(without.level_planes + without.spacing_planes));
   EXPECT_LT(without.z.size(), 20u);
 
-  const TriMesh thick = make_rod(0.2, 1, 24);
+  const TriMesh thick = test::make_rod(0.2, 1, 24);
   EXPECT_EQ(cutting_planes(thick, harmonic_critical_points(thick), options).girth_planes, 0);
 
   // A rod of a hair's width asks for more planes than an int holds: capped, all distinct.
   CuttingPlaneOptions capped;
   capped.girth_max_planes = 50;
-  const TriMesh hair = make_rod(1e-200, 1, 8);
+  const TriMesh hair = test::make_rod(1e-200, 1, 8);
   const CuttingPlanes few = cutting_planes(hair, CriticalPoints{}, capped);
   EXPECT_GT(few.girth_planes, 0);
   EXPECT_LE(few.girth_planes, 50);

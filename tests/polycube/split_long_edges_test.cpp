@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace polycube {
@@ -113,6 +114,24 @@ TEST(SplitLongEdges, RejectsBadArguments) {
   EXPECT_THROW(split_long_edges(mesh, 0, 100), std::invalid_argument);
   EXPECT_THROW(split_long_edges(mesh, -1, 100), std::invalid_argument);
   EXPECT_THROW(split_long_edges(mesh, 1, 0), std::invalid_argument);
+}
+
+
+// The share of the area in slivers: a triangle 100 times as long as high counts at aspect 50, not
+// at 200; an equilateral one never; weighted by area; a rod's sides are almost all of it.
+TEST(SplitLongEdges, SliverAreaShareWeighsTheLongThinTriangles) {
+  TriMesh two;
+  two.V.resize(6, 3);
+  two.V << 0, 0, 0, 1, 0, 0, 0, 0.01, 0,  // legs 1 and 0.01: longest 1.00005, height 0.0099995
+      0, 0, 1, 1, 0, 1, 0.5, std::sqrt(3.0) / 2, 1;  // equilateral, side 1
+  two.F.resize(2, 3);
+  two.F << 0, 1, 2, 3, 4, 5;
+  const double sliver = 0.005, equilateral = std::sqrt(3.0) / 4;
+  EXPECT_NEAR(sliver_area_share(two, 50), sliver / (sliver + equilateral), 1e-12);
+  EXPECT_EQ(sliver_area_share(two, 200), 0);
+  EXPECT_GT(sliver_area_share(test::make_rod(0.001, 1, 24), 50), 0.99);
+  EXPECT_EQ(sliver_area_share(test::make_sphere(2), 50), 0);
+  EXPECT_THROW(sliver_area_share(two, 0), std::invalid_argument);
 }
 
 }  // namespace

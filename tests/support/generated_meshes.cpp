@@ -499,6 +499,27 @@ TriMesh flipped_face_tetrahedron() {
   return to_mesh(points, triangles);
 }
 
+TriMesh make_rod(double radius, double length, int n) {
+  TriMesh rod;
+  rod.V.resize(2 * n + 2, 3);
+  for (int end = 0; end < 2; ++end)
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * M_PI * i / n;
+      rod.V.row(end * n + i) << radius * std::cos(a), radius * std::sin(a), end * length;
+    }
+  rod.V.row(2 * n) << 0, 0, 0;
+  rod.V.row(2 * n + 1) << 0, 0, length;
+  rod.F.resize(4 * n, 3);
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    rod.F.row(4 * i) << i, j, n + j;
+    rod.F.row(4 * i + 1) << i, n + j, n + i;
+    rod.F.row(4 * i + 2) << 2 * n, j, i;
+    rod.F.row(4 * i + 3) << 2 * n + 1, n + i, n + j;
+  }
+  return rod;
+}
+
 TriMesh make_tube(double radius, double height, int n, int rows) {
   TriMesh m;
   m.V.resize(n * (rows + 1), 3);

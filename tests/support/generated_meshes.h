@@ -44,6 +44,11 @@ TriMesh make_cube();
 // quads split along alternating diagonals, outward-oriented; two boundary loops (genus 0).
 TriMesh make_tube(double radius, double height, int n, int rows);
 
+// A closed rod along z from 0 to length: n vertices round each end circle, one quad (two
+// triangles) per side along the whole length, the ends closed by fans round a centre vertex (as
+// CAD models are meshed: slivers when the rod is thin).
+TriMesh make_rod(double radius, double length, int n);
+
 // ---- broken fixtures: each has exactly the defect its name says --------------------------------
 
 // Open tube (radius 1, height 2, 8 segments around, 2 rings of quads) without caps: one
