@@ -89,7 +89,7 @@ constexpr double kRetryHausdorffPercent = 0.5;
 // fandisk within 0.4 deg and 0.05 % of the diagonal either way.
 constexpr long long kSplitEdgesMaxFaces = 100'000;
 // A model with more than this share of its area in triangles kSliverAspect times as long as high
-// is not split (worth_splitting in run_quad).
+// is not split (run_quad).
 constexpr double kSliverAspect = 50;
 constexpr double kSliverShareNoSplit = 0.5;
 
@@ -256,16 +256,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // rod's sides): the splits keep their shape, and on such rods the split model's tries flipped
   // quads and missed by up to 0.98 %, 107–155 s each, where the model as read gave valid quads in
   // 4–31 s (bench/quad.md, thirty-first session). No benchmarked mesh has over 6 % of its area so.
-  double sliver_share = 0;
-  const auto worth_splitting = [&](const TriMesh& mesh) {
-    const double share = sliver_share = sliver_area_share(mesh, kSliverAspect);
-    if (share <= kSliverShareNoSplit) return true;
-    progress.stage("split", "not split: " + std::to_string(static_cast<int>(std::lround(100 * share))) +
+  const bool may_split = options.map_dir.empty() && options.split_edges > 0;
+  const double sliver_share = may_split ? sliver_area_share(prepared.mesh, kSliverAspect) : 0;
+  if (sliver_share > kSliverShareNoSplit)
+    progress.stage("split", "not split: " + std::to_string(static_cast<int>(std::lround(100 * sliver_share))) +
                                 " % of the area is in sliver triangles, which splitting keeps");
-    return false;
-  };
   SplitLongEdges split;
-  if (options.map_dir.empty() && options.split_edges > 0 && worth_splitting(prepared.mesh)) {
+  if (may_split && sliver_share <= kSliverShareNoSplit) {
     split = split_long_edges(prepared.mesh, options.split_edges * split_cell(prepared.mesh), kSplitEdgesMaxFaces);
     if (split.rounds > 0)
       progress.stage("split", std::to_string(split.rounds) + " rounds of long edges split: " + std::to_string(split.mesh.num_faces()) +
