@@ -267,16 +267,25 @@ void pin_anchors(ContourMap& map, std::vector<std::pair<int, int>>& anchors) {
   for (int i = 1; i < n; ++i)
     if (circular_distance(map.polycube_u[i], target(0)) < circular_distance(map.polycube_u[first], target(0))) first = i;
   anchors[0].second = first;
+  // Distances along the loop forwards from the first anchor's vertex, where the later anchors
+  // follow it (F keeps the model's order), not around it either way: a vertex just behind the
+  // first is a whole turn ahead. By circular distance, a second slit end 0.13 % of a contour after
+  // the first, pinned behind it when the first took the only vertex between them, made the pinned
+  // map squeeze the rest of the contour into that vertex's edge (a thin-walled pipe's bands: P's
+  // image 6.8 times the model's area).
+  const double u_first = map.polycube_u[first];
+  const double lead = wrap01(target(0) - u_first + 0.5) - 0.5;  // target(0) from the first vertex, in [-0.5, 0.5)
   int previous = first;
   for (int k = 1; k < k_count; ++k) {
     // Candidates: steps 1 .. n - 1 - (k_count - 1 - k) - (offset of previous from first) after previous.
     const int used = ((previous - first) % n + n) % n;
     const int last_step = n - 1 - (k_count - 1 - k) - used;
+    const double ahead = lead + wrap01(target(k) - target(0));
     int best = -1;
     double best_distance = INFINITY;
     for (int step = 1; step <= last_step; ++step) {
       const int i = (previous + step) % n;
-      const double d = circular_distance(map.polycube_u[i], target(k));
+      const double d = std::abs(wrap01(map.polycube_u[i] - u_first) - ahead);
       if (d < best_distance) {
         best_distance = d;
         best = i;

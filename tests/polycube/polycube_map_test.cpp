@@ -226,6 +226,58 @@ TEST(ContourMap, CircleToSquare) {
   EXPECT_EQ(map.u.size(), map.model_at.size());
 }
 
+// A thin-walled pipe standing on its axis (walls 1.5 % of its diameter apart): each slab's piece
+// is a band, and the slits of the bands below and above a contour end next to each other. The
+// raw map (no refinement, no smoothing) covers the model once: before the slit ends were pinned
+// in order, P's image covered 1.8 times the model's area with 539 / 260 flipped triangles.
+TEST(PolycubeMap, ThinWalledPipeStandingOnItsAxis) {
+  const TriMesh model = make_pipe(1.0, 0.97, 2.0, 96, 16);
+  const Pipeline p = run(model);
+  const MapAudit audit = audit_map(model, p.polycube.polycube.mesh, p.map.polycube_on_model_xyz, p.map.model_on_polycube_xyz);
+  EXPECT_NEAR(audit.polycube_to_model.area_ratio, 1.0, 0.02);
+  EXPECT_EQ(audit.polycube_to_model.flipped, 0);
+  EXPECT_LT(audit.model_to_polycube.flipped, 20);  // the raw map's few, which the untangling clears (`map`: 0)
+}
+
+// Two slit ends close together on a contour whose polygon has one vertex between them and the
+// next a long edge away on either side (a thin-walled pipe's bands: the slits of the pieces below
+// and above end 0.13 % of the contour apart): the second end is pinned after the first, not just
+// behind it, which would leave the pinned map the whole contour but one edge to squeeze into
+// that edge.
+TEST(ContourMap, CloseSlitEndsArePinnedInOrder) {
+  const int n = 720;
+  Eigen::MatrixX3d circle(n, 3), octagon(8, 3);
+  std::vector<int> circle_loop, octagon_loop;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n;
+    circle.row(i) << std::cos(t), std::sin(t), 0.5;
+    circle_loop.push_back(i);
+  }
+  for (int i = 0; i < 8; ++i) {
+    const double t = 2 * M_PI * i / 8 + 0.05;  // a vertex just past both ends
+    octagon.row(i) << std::cos(t), std::sin(t), 0.5;
+    octagon_loop.push_back(i);
+  }
+  const int first_end = 2, second_end = 4;  // at angles 0.017 and 0.035
+  for (const bool reversed : {false, true}) {
+    ContourMap map = start_contour_map(circle_loop, circle, octagon_loop, octagon);
+    add_anchor(map, reversed ? second_end : first_end);
+    add_anchor(map, reversed ? first_end : second_end);
+    finish_contour_map(map, circle, octagon);
+    const int a = anchor_of(map, first_end), b = anchor_of(map, second_end);
+    ASSERT_NE(a, b);
+    // Forwards (counter-clockwise) from the first end to the second: one edge of the octagon, not
+    // seven.
+    double arc = map.polycube_u[b] - map.polycube_u[a];
+    arc -= std::floor(arc);
+    EXPECT_NEAR(arc, 0.125, 1e-9) << (reversed ? "second end added first" : "first end added first");
+    // So the model's contour away from the two ends keeps most of the parameter.
+    double model_arc = map.model_u[first_end] - map.model_u[second_end];
+    model_arc -= std::floor(model_arc);
+    EXPECT_GT(model_arc, 0.8);
+  }
+}
+
 // A tube cut by one slit is a disk; its embedding has no flipped triangle, and splitting inner
 // edges keeps the boundary and the area.
 TEST(PieceDisk, TubeCutAndEmbedded) {

@@ -520,6 +520,36 @@ TriMesh make_rod(double radius, double length, int n) {
   return rod;
 }
 
+TriMesh make_pipe(double outer, double inner, double length, int n, int rows) {
+  TriMesh m;
+  const int ring = n * (rows + 1);  // vertices per wall
+  m.V.resize(2 * ring, 3);
+  for (int wall = 0; wall < 2; ++wall)
+    for (int j = 0; j <= rows; ++j)
+      for (int i = 0; i < n; ++i) {
+        const double r = wall == 0 ? outer : inner, t = 2 * kPi * i / n;
+        m.V.row(wall * ring + j * n + i) << r * std::cos(t), r * std::sin(t), length * j / rows;
+      }
+  std::vector<Eigen::RowVector3i> faces;
+  // A quad a, b, c, d counter-clockwise seen from outside.
+  const auto quad = [&faces](int a, int b, int c, int d) {
+    faces.emplace_back(a, b, c);
+    faces.emplace_back(a, c, d);
+  };
+  for (int i = 0; i < n; ++i) {
+    const int i1 = (i + 1) % n;
+    for (int j = 0; j < rows; ++j) {
+      quad(j * n + i, j * n + i1, (j + 1) * n + i1, (j + 1) * n + i);                                 // outer wall
+      quad(ring + j * n + i, ring + (j + 1) * n + i, ring + (j + 1) * n + i1, ring + j * n + i1);     // inner wall
+    }
+    quad(i, ring + i, ring + i1, i1);                                                                  // end at z = 0
+    quad(rows * n + i, rows * n + i1, ring + rows * n + i1, ring + rows * n + i);                      // end at z = length
+  }
+  m.F.resize(static_cast<int>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f) m.F.row(static_cast<int>(f)) = faces[f];
+  return m;
+}
+
 TriMesh make_tube(double radius, double height, int n, int rows) {
   TriMesh m;
   m.V.resize(n * (rows + 1), 3);

@@ -44,6 +44,11 @@ TriMesh make_cube();
 // quads split along alternating diagonals, outward-oriented; two boundary loops (genus 0).
 TriMesh make_tube(double radius, double height, int n, int rows);
 
+// A closed thin-walled pipe along z from 0 to length (genus 1): n vertices round each ring,
+// rows + 1 rings on the outer wall (radius outer) and on the inner wall (radius inner), quads
+// split along one diagonal, each end an annulus one quad wide; outward-oriented.
+TriMesh make_pipe(double outer, double inner, double length, int n, int rows);
+
 // A closed rod along z from 0 to length: n vertices round each end circle, one quad (two
 // triangles) per side along the whole length, the ends closed by fans round a centre vertex (as
 // CAD models are meshed: slivers when the rod is thin).
