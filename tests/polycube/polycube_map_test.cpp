@@ -259,6 +259,10 @@ TEST(ContourMap, CloseSlitEndsArePinnedInOrder) {
     octagon_loop.push_back(i);
   }
   const int first_end = 2, second_end = 4;  // at angles 0.017 and 0.035
+  // Added in model order, the second end is pinned after the first: the circular rule put it
+  // just behind the first (arc 0.875). Added the other way round, the first pin goes to the
+  // vertex past both ends and the other end to the one before it, by either rule: that case
+  // checks that the insertion order does not matter.
   for (const bool reversed : {false, true}) {
     ContourMap map = start_contour_map(circle_loop, circle, octagon_loop, octagon);
     add_anchor(map, reversed ? second_end : first_end);
