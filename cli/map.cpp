@@ -16,12 +16,15 @@
 #include "polycube/map_quality.h"
 #include "polycube/map_refinement.h"
 #include "polycube/map_smoothing.h"
+#include "polycube/parallel.h"
 #include "polycube/polycube_map.h"
 #include "polycube/topology.h"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <future>
 #include <iomanip>
 #include <memory>
 #include <optional>
@@ -420,15 +423,38 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
       progress.stage("refine", refinement_line(refinement));
       a.refinement_report = {{"map", refinement_json(refinement)}};
       a.refine_seconds = refinement.seconds;
-      std::unique_ptr<Finished> refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
+      // The smoothing of a refined sampling can end worse than that of the unrefined one (it is
+      // a different problem): the refined result is kept only if neither direction has more bad
+      // triangles, or both together have fewer, than the unrefined P's result. The two are
+      // independent, so with two threads or more the unrefined one is finished alongside (its
+      // progress not shown): their untanglings, which run on one thread, overlap.
+      std::unique_ptr<Finished> refined, unrefined;
+      auto finish_unrefined = [&](const Progress& shown) {
+        return finish_map(a.model, planes_z, a.polycube->polycube, *a.map, options, shown);
+      };
+      if (refinement.refined && threads_for(0) > 1) {
+        progress.stage("refine", "the unrefined P's map finished alongside, for comparison");
+        GlobalOptions quiet_options;
+        quiet_options.quiet = true;
+        const Progress quiet(quiet_options);
+        std::future<std::unique_ptr<Finished>> alongside = std::async(std::launch::async, finish_unrefined, std::cref(quiet));
+        try {
+          refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
+        } catch (...) {
+          alongside.wait();
+          throw;
+        }
+        unrefined = alongside.get();
+      } else {
+        refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
+        if (refinement.refined) {
+          progress.stage("refine", "comparing with the unrefined P's smoothed map");
+          unrefined = finish_unrefined(progress);
+        }
+      }
       a.refine_seconds += refined->resample_seconds;
       a.refinement_report["smoothed"] = refined->resampling_report;
       if (refinement.refined) {
-        // The smoothing of a refined sampling can end worse than that of the unrefined one (it
-        // is a different problem): the refined result is kept only if neither direction has
-        // more bad triangles, or both together have fewer, than the unrefined P's result.
-        progress.stage("refine", "comparing with the unrefined P's smoothed map");
-        std::unique_ptr<Finished> unrefined = finish_map(a.model, planes_z, a.polycube->polycube, *a.map, options, progress);
         a.refine_seconds += unrefined->resample_seconds;
         const bool keep = (refined->bad_p() <= unrefined->bad_p() && refined->bad_m() <= unrefined->bad_m()) ||
                           refined->bad_p() + refined->bad_m() < unrefined->bad_p() + unrefined->bad_m();

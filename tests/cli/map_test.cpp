@@ -17,6 +17,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <utility>
 
@@ -458,6 +459,32 @@ TEST(MapCli, QuietRunPrintsNothing) {
   EXPECT_EQ(run.out, "");
 }
 
+
+// When the first refinement changes P, the unrefined P's map is finished on a second thread,
+// alongside the refined one. One thread or more, the files and the comparison are the same.
+TEST(MapCli, TheUnrefinedMapFinishedAlongsideGivesTheSameFiles) {
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one hardware thread: nothing runs alongside";
+  const std::string one = test::temp_dir("map-one-thread"), many = test::temp_dir("map-threads");
+  const std::string input = quoted(test::data_path("double-torus-example.off"));
+  const CliRun sequential = polycube_cli("--threads 1 map --quiet " + input + " -o " + quoted(one));
+  const CliRun alongside = polycube_cli("map --quiet " + input + " -o " + quoted(many));
+  ASSERT_EQ(sequential.code, 0) << sequential.err;
+  ASSERT_EQ(alongside.code, 0) << alongside.err;
+  const auto report = read_json(many + "/report.json");
+  const auto& refinement = report.at("map").at("refinement");
+  ASSERT_TRUE(refinement.at("map").at("refined").get<bool>()) << "the mesh no longer refines: pick another";
+  // The unrefined P's figures (its seconds aside) and the verdict.
+  const auto timeless = [](nlohmann::json unrefined) {
+    unrefined.at("smoothed").erase("seconds");
+    return unrefined;
+  };
+  const nlohmann::json sequential_report = read_json(one + "/report.json");
+  const auto& sequential_refinement = sequential_report.at("map").at("refinement");
+  EXPECT_EQ(timeless(refinement.at("unrefined")), timeless(sequential_refinement.at("unrefined")));
+  EXPECT_EQ(refinement.at("kept"), sequential_refinement.at("kept"));
+  for (const char* file : {"polycube.obj", "polycube_on_model.obj", "model_on_polycube.obj"})
+    EXPECT_EQ(test::read_file(one + "/" + file), test::read_file(many + "/" + file)) << file;
+}
 // A CAD-style rod 1000 times as long as it is wide (24 sides, one sliver pair per side along the
 // whole length, fan caps). At d_z alone its pieces were 13 times as long as their contours, the
 // disk maps crowded, and the map did not finish in 15 minutes; the girth rule's planes make it
