@@ -16,7 +16,7 @@ def write(path, vertices, faces):
         for v in vertices:
             f.write("%.17g %.17g %.17g\n" % v)
         for t in faces:
-            f.write("3 %d %d %d\n" % t)
+            f.write("%d %s\n" % (len(t), " ".join(str(i) for i in t)))
 
 
 def quad(faces, a, b, c, d):

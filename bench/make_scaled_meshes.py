@@ -13,6 +13,8 @@ import os
 import struct
 import sys
 
+from make_cad_meshes import write as write_off
+
 
 def read_off(path):
     """Vertices and faces of an OFF file (comments and blank lines skipped)."""
@@ -37,15 +39,6 @@ def read_off(path):
         faces.append(tuple(int(x) for x in words[at + 1:at + 1 + n]))
         at += 1 + n
     return vertices, faces
-
-
-def write_off(path, vertices, faces):
-    with open(path, "w") as f:
-        f.write("OFF\n%d %d 0\n" % (len(vertices), len(faces)))
-        for v in vertices:
-            f.write("%.17g %.17g %.17g\n" % v)
-        for t in faces:
-            f.write("%d %s\n" % (len(t), " ".join(str(i) for i in t)))
 
 
 def write_binary_stl(path, vertices, faces):
