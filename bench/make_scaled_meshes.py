@@ -2,7 +2,7 @@
 """Writes transformed copies of closed OFF meshes into bench/scaled-data/ (not committed): the
 same surface scaled by 1e-5 and 1e5 about its centroid, moved a few million units from the origin,
 stretched 20 times along z, flattened to 1/20 along z, and the same triangles as a binary STL
-(a triangle soup the reader must weld). A map should not care about the first three; the last
+(in single precision: a triangle soup the reader must weld). A map should not care about the first three; the last
 three are shapes and files users make (first run 2026-12-06, thirty-third session; bench/unseen.md
 has the results).
 
@@ -24,9 +24,9 @@ def read_off(path):
             line = line.split("#", 1)[0].strip()
             if line:
                 words.extend(line.split())
-    if not words or not words[0].endswith("OFF"):
-        raise SystemExit(path + ": not an OFF file")
-    words = words[1:] if words[0] == "OFF" else [words[0][:-3]] + words[1:]
+    if not words or words[0] != "OFF":
+        raise SystemExit(path + ": not a plain OFF file (no COFF, NOFF or 4OFF)")
+    words = words[1:]
     nv, nf = int(words[0]), int(words[1])
     at = 3
     vertices = []

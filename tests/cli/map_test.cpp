@@ -459,7 +459,6 @@ TEST(MapCli, QuietRunPrintsNothing) {
   EXPECT_EQ(run.out, "");
 }
 
-
 // When the first refinement changes P, the unrefined P's map is finished on a second thread,
 // alongside the refined one. One thread or more, the files and the comparison are the same.
 TEST(MapCli, TheUnrefinedMapFinishedAlongsideGivesTheSameFiles) {
