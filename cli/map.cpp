@@ -427,30 +427,27 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
       // a different problem): the refined result is kept only if neither direction has more bad
       // triangles, or both together have fewer, than the unrefined P's result. The two are
       // independent, so with two threads or more the unrefined one is finished alongside (its
-      // progress not shown): their untanglings, which run on one thread, overlap.
-      std::unique_ptr<Finished> refined, unrefined;
+      // progress not shown): their untanglings, which run on one thread, overlap. The future,
+      // declared after what its thread uses, waits for it when destroyed (the refined finish
+      // may throw).
+      GlobalOptions quiet_options;
+      quiet_options.quiet = true;
+      const Progress quiet(quiet_options);
       auto finish_unrefined = [&](const Progress& shown) {
         return finish_map(a.model, planes_z, a.polycube->polycube, *a.map, options, shown);
       };
+      std::future<std::unique_ptr<Finished>> alongside;
       if (refinement.refined && threads_for(0) > 1) {
         progress.stage("refine", "the unrefined P's map finished alongside, for comparison");
-        GlobalOptions quiet_options;
-        quiet_options.quiet = true;
-        const Progress quiet(quiet_options);
-        std::future<std::unique_ptr<Finished>> alongside = std::async(std::launch::async, finish_unrefined, std::cref(quiet));
-        try {
-          refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
-        } catch (...) {
-          alongside.wait();
-          throw;
-        }
+        alongside = std::async(std::launch::async, finish_unrefined, std::cref(quiet));
+      }
+      std::unique_ptr<Finished> refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
+      std::unique_ptr<Finished> unrefined;
+      if (alongside.valid()) {
         unrefined = alongside.get();
-      } else {
-        refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
-        if (refinement.refined) {
-          progress.stage("refine", "comparing with the unrefined P's smoothed map");
-          unrefined = finish_unrefined(progress);
-        }
+      } else if (refinement.refined) {
+        progress.stage("refine", "comparing with the unrefined P's smoothed map");
+        unrefined = finish_unrefined(progress);
       }
       a.refine_seconds += refined->resample_seconds;
       a.refinement_report["smoothed"] = refined->resampling_report;

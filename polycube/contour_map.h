@@ -66,8 +66,9 @@ void add_anchor(ContourMap& map, int model_index);
 // Pins every anchor to a polycube vertex: in the same cyclic order as on the model, the first
 // to the vertex closest (in arc length) to ψ's preimage of its model vertex, each later one to
 // the closest among those that keep the order, arc lengths measured forwards from the first
-// one's vertex (so a vertex just behind it is a whole turn away); then computes model_u, polycube_u, u, model_at, polycube_at and rms_distance. Throws
-// AlgorithmError if the polygon has too few vertices for the anchors.
+// one's vertex (so a vertex just behind it is a whole turn away); then computes model_u,
+// polycube_u, u, model_at, polycube_at and rms_distance. Throws AlgorithmError if the polygon
+// has too few vertices for the anchors.
 void finish_contour_map(ContourMap& map, const Eigen::MatrixX3d& model_V, const Eigen::MatrixX3d& polycube_V);
 
 // After finish_contour_map: the polycube vertex (index into polycube_vertices) pinned to model
