@@ -38,6 +38,22 @@ namespace {
 // The stages `map` can stop after, in pipeline order. The default is the last one built.
 const std::vector<std::string> kStages = {"topology", "polycube", "map"};
 
+// --equalise-axes auto: the copy is made for a long model, whose largest principal standard
+// deviation exceeds the middle one this many times. The 20 shipped meshes reach 3.2 (femur) and
+// meet the contract on the model itself; a 40:2:3 needle is at 11.6, CAD rods 1000 and 3 333
+// times as long as wide at 411 and 1 369. Not for flat ones (a plate, a washer, a sheet: the two
+// largest alike): their own maps met the contract with lower ε_angle (plate 1 x 1 x 0.001: 1.000
+// against 1.082 through the copy; washer 1.032 against 1.186; sheet 1.014 against 1.043).
+constexpr double kEqualiseLength = 5;
+// Its axes are scaled so that their standard deviations are within this ratio of each other.
+constexpr double kEqualiseRatio = 4;
+// The copy's map is kept without a pass on the model itself when it meets the contract with
+// ε_angle at most this; otherwise the model's pass runs too and the better map by rank is kept.
+// The copy's map is finished on the model, but P's faces and the model's surface turn apart under
+// the scaling where they are not parallel: 3 333 : 1 rod 1.088 (the model's own pass did not
+// finish in 26 minutes), 1000 : 1 rod 1.019 (1.049), plate 1 x 1 x 0.01 1.428 (1.001).
+constexpr double kEqualiseKeepAngle = 1.1;
+
 bool runs(const std::string& stop_after, const std::string& stage) {
   const auto at = [](const std::string& s) { return std::find(kStages.begin(), kStages.end(), s) - kStages.begin(); };
   return at(stage) <= at(stop_after);
@@ -49,6 +65,10 @@ struct MapOptions {
   std::string stage = kStages.back();
   std::string align = "auto";
   std::string separate = "always";
+  // auto: a model much longer than wide (kEqualiseLength) is mapped first on a copy with its
+  // principal axes scaled to within kEqualiseRatio of each other (equalised_axes); never: on the
+  // model as it is.
+  std::string equalise_axes = "auto";
   int smooth_sweeps = 10;
   bool refine = true;
   // The last untangling's largest move of an image, × the target's diagonal; 0: none.
@@ -186,6 +206,17 @@ struct Finished {
 // --align none), then its finished map. Heap-held: finished points into refinement or polycube.
 struct Attempt : AlignedStages {
   TriMesh model;  // turned by rotation
+  // An attempt on the scaled copy (--equalise-axes): its topology, polycube, map and first
+  // refinement are built on the copy turned by rotation, whose x, y, z are the model's turned by
+  // `unscaled` times `scales`. Its map is then taken back to the model turned by `unscaled` (P
+  // divided by the scales: still a polycube) and finished there; rotation and model are then
+  // those, and real_polycubes hold the P's taken back (unrefined, refined).
+  Eigen::Vector3d scales = Eigen::Vector3d::Ones();
+  Eigen::Matrix3d unscaled = Eigen::Matrix3d::Identity();
+  const TriMesh* unscaled_source = nullptr;
+  std::unique_ptr<Polycube> real_polycubes[2];
+  std::unique_ptr<PolycubeMap> real_maps[2];
+  bool scaled() const { return unscaled_source != nullptr; }
   std::unique_ptr<MapRefinementResult> refinement;  // P's sampling refined before the smoothing
   std::unique_ptr<Finished> finished;               // after it: the P and sampling written
   nlohmann::json refinement_report = nullptr;
@@ -389,6 +420,42 @@ std::unique_ptr<Finished> exact_map(const TriMesh& model, const Polycube& P, con
   return out;
 }
 
+// P built on a scaled copy (--equalise-axes), its coordinates divided by the copy's scales: an
+// axis-aligned scaling keeps its faces axis-aligned and its structure.
+Polycube unscaled_polycube(const Polycube& P, const Eigen::Vector3d& scales) {
+  Polycube out = P;
+  const Eigen::Vector3d inverse = scales.cwiseInverse();
+  out.mesh.V = P.mesh.V * inverse.asDiagonal();
+  for (PolycubeFace& f : out.faces) {
+    f.coordinate *= inverse(f.axis);
+    f.area *= inverse((f.axis + 1) % 3) * inverse((f.axis + 2) % 3);
+  }
+  for (std::vector<SectionPolygon>& plane : out.sections)
+    for (SectionPolygon& polygon : plane)
+      for (Eigen::Vector2d& q : polygon.points) q = q.cwiseProduct(inverse.head<2>());
+  for (double& z : out.levels) z *= inverse(2);
+  out.spacing = 0;
+  for (const PolycubeEdge& e : out.edges)
+    for (size_t k = 0; k + 1 < e.vertices.size(); ++k)
+      out.spacing = std::max(out.spacing, (out.mesh.V.row(e.vertices[k + 1]) - out.mesh.V.row(e.vertices[k])).norm());
+  return out;
+}
+
+// φ sampled at the vertices of both meshes, taken back the same way (surface points are
+// barycentric, so they stay). Without the copy's map data: what finishes a map needs only the
+// samples.
+PolycubeMap unscaled_map(const PolycubeMap& map, const Eigen::Vector3d& scales) {
+  PolycubeMap out;
+  out.polycube_on_model = map.polycube_on_model;
+  out.model_on_polycube = map.model_on_polycube;
+  out.polycube_on_model_xyz = map.polycube_on_model_xyz * scales.cwiseInverse().asDiagonal();
+  out.model_on_polycube_xyz = map.model_on_polycube_xyz * scales.cwiseInverse().asDiagonal();
+  out.pieces = map.pieces;
+  out.contours = map.contours;
+  out.seconds = map.seconds;
+  return out;
+}
+
 // The stages of one orientation that the search did not build (all of them with --align none),
 // up to the stage asked; with the map, its refinement and finish. P's sampling of φ is refined
 // where its chords flip or lose area (issue 5) before the smoothing (φ itself at the new
@@ -398,7 +465,11 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
   const double start = progress.elapsed_seconds();
   a.model = rotated(input, a.rotation);
   progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
-  if (!a.topology) a.topology = std::make_shared<TopologyResult>(analyse_topology(a.model, options.topology));
+  if (!a.topology) {
+    TopologyOptions topology = options.topology;
+    topology.length_scales = a.scales;
+    a.topology = std::make_shared<TopologyResult>(analyse_topology(a.model, topology));
+  }
   progress.stage("topology", std::to_string(a.topology->critical.saddle_count()) + " saddles, " +
                                  std::to_string(a.topology->planes_z.size()) + " planes, " +
                                  std::to_string(a.topology->sliced.pieces.size()) + " genus-0 pieces");
@@ -413,16 +484,44 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
   if (runs(options.stage, "map")) {
     progress.stage("map", "boundary maps, slits, disk maps of " + std::to_string(a.polycube->piece_match.size()) + " piece pairs");
     if (!a.map) a.map = std::make_shared<PolycubeMap>(build_polycube_map(a.model, *a.polycube));
-    const std::vector<double>& planes_z = a.polycube->planes_z;
-    if (!options.refine) {
-      a.finished = finish_map(a.model, planes_z, a.polycube->polycube, *a.map, options, progress);
-    } else {
+    // What is finished: the model turned, P and φ sampled at its vertices (unrefined and refined).
+    std::vector<double> planes_z = a.polycube->planes_z;
+    const Polycube* unrefined_polycube = &a.polycube->polycube;
+    const PolycubeMap* unrefined_map = a.map.get();
+    if (options.refine) {
       progress.stage("refine", "bisecting P's triangles where the map sampled at its vertices flips or loses area");
       a.refinement = std::make_unique<MapRefinementResult>(refine_map_sampling(a.model, *a.polycube, *a.map));
+      progress.stage("refine", refinement_line(*a.refinement));
+      a.refinement_report = {{"map", refinement_json(*a.refinement)}};
+      a.refine_seconds = a.refinement->seconds;
+    }
+    const Polycube* refined_polycube = a.refinement ? &a.refinement->polycube : nullptr;
+    const PolycubeMap* refined_map = a.refinement ? &a.refinement->map : nullptr;
+    if (a.scaled()) {
+      // The copy's P and φ taken back to the model (turned by `unscaled`), finished there: the
+      // smoothing then works against the model's own angles.
+      std::ostringstream said;
+      said << std::setprecision(3) << "the copy's P and map taken back to the model (x, y, z divided by " << a.scales(0) << ", "
+           << a.scales(1) << ", " << a.scales(2) << ")";
+      progress.stage("equalise", said.str());
+      a.model = rotated(*a.unscaled_source, a.unscaled);
+      a.rotation = a.unscaled;
+      for (double& z : planes_z) z /= a.scales(2);
+      a.real_polycubes[0] = std::make_unique<Polycube>(unscaled_polycube(*unrefined_polycube, a.scales));
+      a.real_maps[0] = std::make_unique<PolycubeMap>(unscaled_map(*unrefined_map, a.scales));
+      unrefined_polycube = a.real_polycubes[0].get();
+      unrefined_map = a.real_maps[0].get();
+      if (refined_polycube) {
+        a.real_polycubes[1] = std::make_unique<Polycube>(unscaled_polycube(*refined_polycube, a.scales));
+        a.real_maps[1] = std::make_unique<PolycubeMap>(unscaled_map(*refined_map, a.scales));
+        refined_polycube = a.real_polycubes[1].get();
+        refined_map = a.real_maps[1].get();
+      }
+    }
+    if (!options.refine) {
+      a.finished = finish_map(a.model, planes_z, *unrefined_polycube, *unrefined_map, options, progress);
+    } else {
       const MapRefinementResult& refinement = *a.refinement;
-      progress.stage("refine", refinement_line(refinement));
-      a.refinement_report = {{"map", refinement_json(refinement)}};
-      a.refine_seconds = refinement.seconds;
       // The smoothing of a refined sampling can end worse than that of the unrefined one (it is
       // a different problem): the refined result is kept only if neither direction has more bad
       // triangles, or both together have fewer, than the unrefined P's result. The two are
@@ -434,14 +533,14 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
       quiet_options.quiet = true;
       const Progress quiet(quiet_options);
       auto finish_unrefined = [&](const Progress& shown) {
-        return finish_map(a.model, planes_z, a.polycube->polycube, *a.map, options, shown);
+        return finish_map(a.model, planes_z, *unrefined_polycube, *unrefined_map, options, shown);
       };
       std::future<std::unique_ptr<Finished>> alongside;
       if (refinement.refined && threads_for(0) > 1) {
         progress.stage("refine", "the unrefined P's map finished alongside, for comparison");
         alongside = std::async(std::launch::async, finish_unrefined, std::cref(quiet));
       }
-      std::unique_ptr<Finished> refined = finish_map(a.model, planes_z, refinement.polycube, refinement.map, options, progress);
+      std::unique_ptr<Finished> refined = finish_map(a.model, planes_z, *refined_polycube, *refined_map, options, progress);
       std::unique_ptr<Finished> unrefined;
       if (alongside.valid()) {
         unrefined = alongside.get();
@@ -520,7 +619,16 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     return "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " + std::to_string(kept->finished->bad_m()) +
            " flipped, image area " + std::to_string(kept->finished->audit.polycube_to_model.area_ratio) + "; ";
   };
-  auto run_pass = [&](const MapOptions& pass, nlohmann::json& alignment_report, const std::string& suffix) {
+  // A pass on the scaled copy (equalised_axes: source turned to its principal axes, then scaled)
+  // runs its stages on `copy`.
+  struct Equalised {
+    TriMesh copy;
+    Eigen::Matrix3d axes;
+    Eigen::Vector3d scales;
+  };
+  auto run_pass = [&](const MapOptions& pass, nlohmann::json& alignment_report, const std::string& suffix,
+                      const Equalised* equalised = nullptr) {
+    const TriMesh& stages_source = equalised ? equalised->copy : source;
     Alignment alignment;
     if (pass.align == "auto" && pass.stage != "topology") {
       const double align_start = progress.elapsed_seconds();
@@ -528,7 +636,18 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       // A later search (there is a map already) ends where the time limit is spent.
       AlignmentOptions align_options;
       if (kept) align_options.stop = time_limit.stop_for(progress);
-      alignment = choose_alignment(source, pass.topology, pass.polycube, align_options);
+      align_options.input_frame_only = equalised != nullptr;
+      if (equalised) align_options.axis_scales = equalised->scales;
+      alignment = choose_alignment(stages_source, pass.topology, pass.polycube, align_options);
+      if (equalised) {
+        // The copy's frame is the model's principal axes, largest spread first.
+        const std::vector<std::pair<std::string, std::string>> names = {{"input frame, z up", "principal axes, least-spread axis up"},
+                                                                        {"input frame, x up", "principal axes, longest axis up"},
+                                                                        {"input frame, y up", "principal axes, middle axis up"}};
+        for (AlignmentCandidate& c : alignment.candidates)
+          for (const auto& [from, to] : names)
+            if (c.name.rfind(from, 0) == 0) c.name = to + c.name.substr(from.size());
+      }
       nlohmann::json candidates = nlohmann::json::array();
       for (const AlignmentCandidate& c : alignment.candidates)
         candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle}, {"eps_area", c.eps_area},
@@ -557,13 +676,20 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       static_cast<AlignedStages&>(*attempts.back()) = stages;
       attempts.back()->name = (stages.candidate >= 0 ? alignment.candidates[stages.candidate].name : std::string("input frame")) + suffix;
       attempts.back()->da = pass.polycube.da;
+      if (equalised) {
+        // The candidate's rotation only permutes the copy's axes (input frame only).
+        Attempt& a = *attempts.back();
+        a.scales = a.rotation.cwiseAbs() * equalised->scales;
+        a.unscaled = a.rotation * equalised->axes;
+        a.unscaled_source = &source;
+      }
     }
     if (first_choice.empty()) first_choice = attempts[first]->name;
     for (size_t i = first; i < attempts.size(); ++i) {
       Attempt& a = *attempts[i];
       if (kept && time_limit.spent(progress)) return;
       if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
-      run_stages(a, source, pass, progress);
+      run_stages(a, stages_source, pass, progress);
       if (!a.finished) {
         kept = &a;
         return;
@@ -572,7 +698,36 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (kept->finished->meets_contract()) return;
     }
   };
-  run_pass(options, report["alignment"], "");
+  // A model much longer than wide: first on its scaled copy (kEqualiseLength); the
+  // model itself follows when that map misses the contract, is far from conformal
+  // (kEqualiseKeepAngle) or cannot be built, and the two compete by rank.
+  Eigen::Vector3d deviations, scales;
+  const Eigen::Matrix3d frame = equalised_axes(source, kEqualiseRatio, &deviations, &scales);
+  if (options.equalise_axes == "auto" && options.align == "auto" && runs(options.stage, "map") &&
+      deviations(0) > kEqualiseLength * deviations(1) && !frame.isIdentity(0)) {
+    Equalised equalised{rotated(source, frame), principal_axes(source), scales};
+    std::ostringstream said;
+    said << std::setprecision(3) << "principal deviations " << deviations(0) << ", " << deviations(1) << ", " << deviations(2)
+         << ": first on a copy with its axes scaled by " << scales(0) << ", " << scales(1) << ", " << scales(2);
+    progress.stage("equalise", said.str());
+    report["alignment"]["equalised"] = {{"deviations", {deviations(0), deviations(1), deviations(2)}},
+                                        {"scales", {scales(0), scales(1), scales(2)}}};
+    try {
+      run_pass(options, report["alignment"]["equalised"], ", on a copy scaled along them", &equalised);
+    } catch (const Error& e) {
+      progress.warning(std::string("the scaled copy: ") + e.what());
+      report["alignment"]["equalised"]["error"] = e.what();
+    }
+  }
+  if (!kept || (kept->finished && (!kept->finished->meets_contract() || kept->finished->audit.distortion.eps_angle > kEqualiseKeepAngle))) {
+    if (kept) {
+      const Finished& copy = *kept->finished;
+      progress.stage("equalise", "the copy's map " +
+                                     (copy.meets_contract() ? "has eps_angle " + std::to_string(copy.audit.distortion.eps_angle) : shortfall()) +
+                                     "; now the model itself");
+    }
+    run_pass(options, report["alignment"], "");
+  }
   // Still short of the contract: everything once more with finer contours. Where the quadtree
   // drops a thin part of a cross-section (a tail, a horn, a hoof), P has nothing for it and the
   // map squeezes it towards a point, where the chords of P's images miss its area (bull: a horn
@@ -598,7 +753,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   if (options.exact && kept && kept->finished && !kept->finished->meets_contract()) {
     std::vector<Attempt*> order;
     for (const auto& a : attempts)
-      if (a->finished && a->map) order.push_back(a.get());
+      if (a->finished && a->map && !a->scaled()) order.push_back(a.get());  // (a scaled copy's map data is the copy's)
     std::stable_sort(order.begin(), order.end(), [](const Attempt* x, const Attempt* y) { return x->finished->rank() < y->finished->rank(); });
     for (Attempt* a : order) {
       if (time_limit.spent(progress)) break;
@@ -644,10 +799,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   const Attempt& chosen = *kept;
   const Eigen::Matrix3d rotation = chosen.rotation;
   const auto finished_attempts = std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->finished != nullptr; });
-  if (chosen.name != first_choice) {
-    report["alignment"]["chosen"] = chosen.name;
-    progress.stage("retry", "kept " + chosen.name);
-  }
+  report["alignment"]["chosen"] = chosen.name;
+  if (chosen.name != first_choice) progress.stage("retry", "kept " + chosen.name);
   if (finished_attempts > 1) {
     nlohmann::json finished = nlohmann::json::array();
     for (const std::unique_ptr<Attempt>& a : attempts) {
@@ -667,6 +820,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   report["alignment"]["rotation"] = {{rotation(0, 0), rotation(0, 1), rotation(0, 2)},
                                      {rotation(1, 0), rotation(1, 1), rotation(1, 2)},
                                      {rotation(2, 0), rotation(2, 1), rotation(2, 2)}};
+  // The scales of the copy the stages ran on (1 unless scaled): its x, y, z are the turned
+  // frame's times these.
+  report["alignment"]["axis_scales"] = {chosen.scales(0), chosen.scales(1), chosen.scales(2)};
   const TriMesh& model = chosen.model;
   // Positions of the turned frame back in the input's (x = rotation^T x_turned).
   auto to_input = [&rotation](const Eigen::MatrixX3d& V) -> Eigen::MatrixX3d { return V * rotation; };
@@ -693,6 +849,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   if (polycube) {
     model_pieces = &polycube->model_sliced;
     report["polycube"] = polycube_json(*polycube);
+    if (chosen.scaled()) {
+      std::vector<double> planes = polycube->planes_z;
+      for (double& z : planes) z /= chosen.scales(2);
+      report["polycube"]["planes"] = planes;
+    }
     report["polycube"]["da"] = chosen.da;
     seconds["polycube"] = polycube->seconds_total;
     written_polycube = &polycube->polycube;
@@ -795,7 +956,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
 
   const std::string pieces_path = (dir / "pieces.ply").string();
   SlicedMesh pieces_in_input = *model_pieces;
-  pieces_in_input.mesh.V = placed_as_input(prepared, to_input(model_pieces->mesh.V));
+  // (The slicing of a scaled copy's model, taken back: slicing by planes commutes with scaling.)
+  pieces_in_input.mesh.V = placed_as_input(prepared, to_input(model_pieces->mesh.V * chosen.scales.cwiseInverse().asDiagonal()));
   write_pieces(pieces_path, pieces_in_input);
   outputs.push_back(pieces_path);
   const std::string preview_path = (dir / "preview.png").string();
@@ -840,6 +1002,14 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "fewest flipped triangles; none: keep the input's orientation")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "none"}));
+  command->add_option("--equalise-axes", options->equalise_axes,
+                      "auto: a model far longer than wide (its largest principal deviation over 5 times the next) is mapped "
+                      "first on a copy with its principal axes scaled to within 4 times of each other (P, built along them, "
+                      "scaled back is still a polycube; the map is finished on the model); the model itself too when that map "
+                      "misses the contract or has eps_angle above 1.1, the better kept; never: only the model itself. Only "
+                      "with --align auto")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "never"}));
   command->add_option("--separate", options->separate,
                       "A model that intersects itself: always: build everything on a copy pulled apart round the crossings "
                       "(local smoothing; a cutting plane's contours must not cross), P's images moved back onto the model at the "

@@ -36,9 +36,8 @@ Eigen::Matrix3d snapped_to_coordinate_axes(const Eigen::Matrix3d& axes) {
   return axes;
 }
 
-}  // namespace
-
-Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread) {
+// principal_axes, with the variances along the returned rows (when asked).
+Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread, Eigen::Vector3d* variances) {
   // Second moments of the surface, each triangle integrated exactly (vertices and centroid rule).
   double area_sum = 0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -53,6 +52,7 @@ Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread) {
     second += area / 12 * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
   }
   if (spread) *spread = 1;
+  if (variances) variances->setZero();
   if (!(area_sum > 0)) return Eigen::Matrix3d::Identity();
   mean /= area_sum;
   const Eigen::Matrix3d covariance = second / area_sum - mean * mean.transpose();
@@ -61,7 +61,29 @@ Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread) {
   Eigen::Matrix3d axes;
   for (int i = 0; i < 3; ++i) axes.row(i) = solver.eigenvectors().col(2 - i).transpose();  // largest first
   if (axes.determinant() < 0) axes.row(2) *= -1;
-  return snapped_to_coordinate_axes(axes);
+  axes = snapped_to_coordinate_axes(axes);
+  if (variances)
+    for (int i = 0; i < 3; ++i) (*variances)(i) = axes.row(i) * covariance * axes.row(i).transpose();
+  return axes;
+}
+
+}  // namespace
+
+Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread) { return principal_axes(mesh, spread, nullptr); }
+
+Eigen::Matrix3d equalised_axes(const TriMesh& mesh, double max_ratio, Eigen::Vector3d* deviations, Eigen::Vector3d* scales) {
+  Eigen::Vector3d variances;
+  const Eigen::Matrix3d axes = principal_axes(mesh, nullptr, &variances);
+  const Eigen::Vector3d sigma = variances.cwiseMax(0).cwiseSqrt();
+  if (deviations) *deviations = sigma;
+  if (scales) *scales = Eigen::Vector3d::Ones();
+  if (!(sigma.minCoeff() > 0) || !(sigma.maxCoeff() > max_ratio * sigma.minCoeff())) return Eigen::Matrix3d::Identity();
+  const double mean = std::cbrt(sigma.prod()), band = std::sqrt(max_ratio);
+  Eigen::Vector3d s;
+  for (int i = 0; i < 3; ++i) s(i) = std::clamp(sigma(i), mean / band, mean * band) / sigma(i);
+  s /= std::cbrt(s.prod());
+  if (scales) *scales = s;
+  return s.asDiagonal() * axes;
 }
 
 Eigen::Matrix3d normal_axes(const TriMesh& mesh, int max_faces, double* misalignment) {
@@ -193,9 +215,16 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     none.stopped = true;
     return none;
   };
+  // A scaled copy's axes, as each candidate turns them (AlignmentOptions::axis_scales).
+  const auto turned_topology = [&](const Eigen::Matrix3d& rotation) {
+    TopologyOptions turned = topology;
+    // (Only the input frame's axes, permuted, are candidates then.)
+    if (options.axis_scales != Eigen::Vector3d::Ones()) turned.length_scales = rotation.cwiseAbs() * options.axis_scales;
+    return turned;
+  };
   double spread = 1;
   const Eigen::Matrix3d pca = principal_axes(mesh, &spread);
-  const bool reserve_principal = !(spread >= options.principal_axes_spread);
+  const bool reserve_principal = !options.input_frame_only && !(spread >= options.principal_axes_spread);
   // A large model is scored on a coarser copy (same topology); the winner's stages are then built
   // on the model itself.
   TriMesh proxy;
@@ -218,8 +247,10 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   // otherwise in reserve: tried only when no other candidate passes the scoring budget. Never when
   // it is one of the others (a CAD part in its own frame, or a box, already has it).
   double misalignment = 0;
-  const Eigen::Matrix3d normals = normal_axes(mesh, 20000, &misalignment);
-  const bool distinct_normals = !same_axes(normals, Eigen::Matrix3d::Identity()) && !same_axes(normals, pca);
+  const Eigen::Matrix3d normals =
+      options.input_frame_only ? Eigen::Matrix3d::Identity() : normal_axes(mesh, 20000, &misalignment);
+  const bool distinct_normals =
+      !options.input_frame_only && !same_axes(normals, Eigen::Matrix3d::Identity()) && !same_axes(normals, pca);
   const bool reserve_normals = distinct_normals && !(misalignment < options.normal_axes_misalignment);
   auto add_frame = [&](int frame) {
     for (int k = 0; k < 3; ++k) {
@@ -230,7 +261,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     }
   };
   add_frame(0);
-  if (!reserve_principal) add_frame(1);
+  if (!reserve_principal && !options.input_frame_only) add_frame(1);
   if (distinct_normals && !reserve_normals) add_frame(2);
   PolycubeOptions scoring = polycube;
   scoring.max_rounds = std::min(scoring.max_rounds, options.max_rounds);
@@ -264,7 +295,8 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     const long long work = rasterized_cells();
     try {
       if (turned[i].num_faces() == 0) turned[i] = rotated(scored, c.rotation);
-      if (!topologies[i]) topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], topology, harmonic.get()));
+      if (!topologies[i])
+        topologies[i] = std::make_shared<TopologyResult>(analyse_topology(turned[i], turned_topology(c.rotation), harmonic.get()));
       polycubes[i] = std::make_shared<PolycubeResult>(build_polycube(turned[i], *topologies[i], budget));
       c.corners = static_cast<int>(polycubes[i]->polycube.corners.size());
       c.failing_slabs = 0;
@@ -458,7 +490,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
       const auto start = std::chrono::steady_clock::now();
       try {
         const TriMesh full = rotated(mesh, c.rotation);
-        auto full_topology = std::make_shared<TopologyResult>(analyse_topology(full, topology));
+        auto full_topology = std::make_shared<TopologyResult>(analyse_topology(full, turned_topology(c.rotation)));
         auto full_polycube = std::make_shared<PolycubeResult>(build_polycube(full, *full_topology, polycube));
         out.topology = std::move(full_topology);
         out.polycube = std::move(full_polycube);

@@ -89,6 +89,18 @@ struct Alignment {
 // whose principal axes are any axes: rounding picks them).
 Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread = nullptr);
 
+// The frame a very long model is first mapped in (map --equalise-axes): its principal axes (the
+// rows of principal_axes), each scaled so that the surface's standard deviations along them come
+// within max_ratio of each other (those beyond the geometric mean's band, sqrt(max_ratio) either
+// way, are brought to its edge; the scales' product is 1). A copy turned by it (rotated(mesh,
+// frame): V * frame^T) is a linear image of the model, and scaling along the axes keeps a
+// polycube built in the copy's frame axis-aligned: the copy's P, scaled back, is a polycube of the
+// model. deviations (optional): the model's standard deviations along the axes, largest first.
+// scales (optional): the three factors, row by row. The identity, unscaled, when every ratio is
+// within max_ratio.
+Eigen::Matrix3d equalised_axes(const TriMesh& mesh, double max_ratio, Eigen::Vector3d* deviations = nullptr,
+                               Eigen::Vector3d* scales = nullptr);
+
 // The frame whose axes the surface normals align with best, as the rows of a proper rotation: the
 // minimiser of Σ_f area_f (x²y² + y²z² + z²x²) over the faces' unit normals (x, y, z) in that
 // frame, which is 0 exactly when every face is perpendicular to an axis (a CAD part in its own
@@ -129,6 +141,12 @@ struct AlignmentOptions {
   // copy turned to its least-spread principal axis spent 108 s on 2.0e9 cells and failed all the
   // same (bench/map.md, thirty-first session). 0: no limit.
   double max_fallback_rasterized_cells = 5e8;
+  // Only the input frame's three axes are candidates, in the fallbacks too (a copy whose own frame
+  // must be kept: one scaled along its axes, equalised_axes).
+  bool input_frame_only = false;
+  // The mesh is a copy whose x, y, z are a model's times these (with input_frame_only): each
+  // candidate's girth rule measures on the model (TopologyOptions::length_scales).
+  Eigen::Vector3d axis_scales = Eigen::Vector3d::Ones();
   // How many candidates (fewest corners first) get their map built and audited first; if all of
   // those still have flipped triangles, the rest are mapped too. 0: corners only.
   int mapped_candidates = 2;

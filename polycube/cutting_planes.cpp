@@ -12,7 +12,7 @@
 
 namespace polycube {
 
-std::vector<double> longest_contours(const TriMesh& mesh, const std::vector<double>& z) {
+std::vector<double> longest_contours(const TriMesh& mesh, const std::vector<double>& z, const Eigen::Vector3d& scales) {
   const int n = static_cast<int>(z.size());
   // Per plane, the segments of its contour: the two crossed edges (keys) and the length.
   struct Segment {
@@ -41,7 +41,7 @@ std::vector<double> longest_contours(const TriMesh& mesh, const std::vector<doub
         point[found] = mesh.V.row(v[i]).transpose() + t * (mesh.V.row(v[j]) - mesh.V.row(v[i])).transpose();
         edge[found++] = key(v[i], v[j]);
       }
-      if (found == 2) segments[p].push_back({edge[0], edge[1], (point[1] - point[0]).norm()});
+      if (found == 2) segments[p].push_back({edge[0], edge[1], (point[1] - point[0]).cwiseQuotient(scales).norm()});
     }
   }
   std::vector<double> longest(n, 0);
@@ -70,8 +70,9 @@ std::vector<double> longest_contours(const TriMesh& mesh, const std::vector<doub
 CuttingPlanes cutting_planes(const TriMesh& mesh, const CriticalPoints& critical, const CuttingPlaneOptions& options) {
   if (!(options.dz > 0)) throw std::invalid_argument("cutting_planes: dz must be positive");
   if (!(options.level_merge >= 0)) throw std::invalid_argument("cutting_planes: level_merge must be >= 0");
-  if (!(options.girth_ratio >= 0) || (options.girth_ratio > 0 && !(options.girth_spacing > 0)) || options.girth_max_planes < 0)
-    throw std::invalid_argument("cutting_planes: girth_ratio must be >= 0, girth_spacing > 0 and girth_max_planes >= 0");
+  if (!(options.girth_ratio >= 0) || (options.girth_ratio > 0 && !(options.girth_spacing > 0)) || options.girth_max_planes < 0 ||
+      !(options.length_scales.minCoeff() > 0))
+    throw std::invalid_argument("cutting_planes: girth_ratio must be >= 0, girth_spacing > 0, girth_max_planes >= 0 and length_scales > 0");
   const BoundingBox box = bounding_box(mesh.V);
   const double z_min = box.min.z(), z_max = box.max.z();
   if (!(z_max > z_min)) throw MeshError("cutting_planes: mesh has no height (all z equal)");
@@ -131,19 +132,19 @@ CuttingPlanes cutting_planes(const TriMesh& mesh, const CriticalPoints& critical
   // The girth rule: gaps long against the sections bounding them are split; the new planes'
   // sections may be thinner still (a tapering rod), so a few passes.
   for (int pass = 0; pass < 3 && options.girth_ratio > 0 && result.girth_planes < options.girth_max_planes; ++pass) {
-    const std::vector<double> longest = longest_contours(mesh, planes);
+    const std::vector<double> longest = longest_contours(mesh, planes, options.length_scales);
     std::vector<double> added;
     const int n = static_cast<int>(planes.size());
     for (int g = 0; g <= n; ++g) {
       if ((g == 0 || g == n) && !options.split_end_gaps) continue;
       const double lo = g == 0 ? z_min : planes[g - 1], hi = g == n ? z_max : planes[g];
       const double girth = std::max(g > 0 ? longest[g - 1] : 0.0, g < n ? longest[g] : 0.0);
-      const double gap = hi - lo;
+      const double gap = (hi - lo) / options.length_scales(2);
       if (!(girth > 0) || !(gap > options.girth_ratio * girth)) continue;
       // Capped in doubles first: a contour of a hair's length asks for more planes than an int.
       const double room = options.girth_max_planes - result.girth_planes - static_cast<double>(added.size());
       const int extra = static_cast<int>(std::min(room, std::ceil(gap / (options.girth_spacing * girth)) - 1));
-      const double step = gap / (extra + 1);
+      const double step = (hi - lo) / (extra + 1);
       for (int k = 1; k <= extra; ++k) added.push_back(place_plane(heights, lo + k * step, lo, hi, 0.25 * step));
     }
     if (added.empty()) break;

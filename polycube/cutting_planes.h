@@ -5,6 +5,8 @@
 #include "polycube/critical_points.h"
 #include "polycube/mesh.h"
 
+#include <Eigen/Core>
+
 #include <vector>
 
 namespace polycube {
@@ -33,6 +35,11 @@ struct CuttingPlaneOptions {
   double girth_ratio = 4;
   double girth_spacing = 1;
   int girth_max_planes = 1000;
+  // The mesh is a copy whose x, y, z are a model's times these (map --equalise-axes scales a long
+  // or flat model's axes towards equal spreads); the girth rule measures gaps and contours on that
+  // model, whose map the copy's is taken back to: the planes pin the map level by level, and a
+  // copy's slab that is short against its section can be long on the model.
+  Eigen::Vector3d length_scales = Eigen::Vector3d::Ones();
 };
 
 // Planes in input coordinates and in normalised height (z - z_min) / (largest bounding-box side).
@@ -51,8 +58,10 @@ struct CuttingPlanes {
 
 // Per plane (ascending heights), the length of its longest contour: the level set of z on the
 // mesh (triangles crossing the height, joined across the edges they share). 0 for a plane that
-// meets no triangle.
-std::vector<double> longest_contours(const TriMesh& mesh, const std::vector<double>& z);
+// meets no triangle. Lengths are measured with the coordinates divided by scales (a scaled copy's
+// contours measured on its model: CuttingPlaneOptions::length_scales).
+std::vector<double> longest_contours(const TriMesh& mesh, const std::vector<double>& z,
+                                     const Eigen::Vector3d& scales = Eigen::Vector3d::Ones());
 
 // Sorts the critical points (minima, saddles, maxima) and the lowest and highest vertex by z and
 // merges them into levels: sorted heights closer than level_merge * height join one level.

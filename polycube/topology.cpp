@@ -357,6 +357,7 @@ TopologyResult analyse_topology(const TriMesh& mesh, const TopologyOptions& opti
   planes_options.dz = options.dz;
   planes_options.level_merge = options.level_merge;
   planes_options.split_end_gaps = options.split_end_gaps;
+  planes_options.length_scales = options.length_scales;
   result.initial_planes = cutting_planes(mesh, result.critical, planes_options);
   std::vector<double> planes = result.initial_planes.z;
   result.seconds_planes = seconds_since(t);

@@ -21,6 +21,8 @@ struct TopologyOptions {
   bool split_end_gaps = true;
   // Most planes in total (from §3.2 and added for genus) before giving up with AlgorithmError.
   int max_planes = 2000;
+  // CuttingPlaneOptions::length_scales (a scaled copy's girth rule measured on its model).
+  Eigen::Vector3d length_scales = Eigen::Vector3d::Ones();
   HarmonicOptions harmonic;
 };
 

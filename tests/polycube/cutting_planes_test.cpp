@@ -192,6 +192,29 @@ TEST(CuttingPlanes, AThinRodGetsPlanesAlongItsLength) {
   EXPECT_EQ(static_cast<int>(few.z.size()), few.level_planes + few.spacing_planes + few.girth_planes);
 }
 
+// A copy of that rod scaled towards equal spreads (map --equalise-axes): measured on the copy its
+// slabs are short against their sections and the rule adds nothing; told the copy's scales, it
+// measures on the rod and places the rod's planes, scaled.
+TEST(CuttingPlanes, AScaledCopyGetsTheGirthPlanesOfItsModel) {
+  const TriMesh rod = test::make_rod(0.001, 1, 24);
+  const Eigen::Vector3d scales(10, 10, 0.01);
+  TriMesh copy = rod;
+  copy.V = rod.V * scales.asDiagonal();
+  const CriticalPoints c = harmonic_critical_points(rod);
+  // (d_z, a fraction of the largest side, is left out: the copy's largest side is its diameter.)
+  CuttingPlaneOptions options;
+  options.dz = 1;
+  const CuttingPlanes planes = cutting_planes(rod, c, options);
+  ASSERT_GT(planes.girth_planes, 100);
+  EXPECT_EQ(cutting_planes(copy, c, options).girth_planes, 0);
+  CuttingPlaneOptions measured_on_rod = options;
+  measured_on_rod.length_scales = scales;
+  const CuttingPlanes on_copy = cutting_planes(copy, c, measured_on_rod);
+  EXPECT_EQ(on_copy.girth_planes, planes.girth_planes);
+  ASSERT_EQ(on_copy.z.size(), planes.z.size());
+  for (size_t k = 0; k < planes.z.size(); ++k) EXPECT_NEAR(on_copy.z[k], planes.z[k] * scales(2), 1e-12) << "plane " << k;
+}
+
 TEST(CuttingPlanes, RejectsBadOptions) {
   const TriMesh sphere = test::make_sphere(1);
   const CriticalPoints c = harmonic_critical_points(sphere);
@@ -206,6 +229,9 @@ TEST(CuttingPlanes, RejectsBadOptions) {
   EXPECT_THROW(cutting_planes(sphere, c, options), std::invalid_argument);
   options.girth_ratio = 4;
   options.girth_spacing = 0;
+  EXPECT_THROW(cutting_planes(sphere, c, options), std::invalid_argument);
+  options.girth_spacing = 1;
+  options.length_scales = Eigen::Vector3d(1, 0, 1);
   EXPECT_THROW(cutting_planes(sphere, c, options), std::invalid_argument);
   TriMesh flat = sphere;
   flat.V.col(2).setZero();
