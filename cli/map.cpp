@@ -722,9 +722,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   if (!kept || (kept->finished && (!kept->finished->meets_contract() || kept->finished->audit.distortion.eps_angle > kEqualiseKeepAngle))) {
     if (kept) {
       const Finished& copy = *kept->finished;
-      progress.stage("equalise", "the copy's map " +
-                                     (copy.meets_contract() ? "has eps_angle " + std::to_string(copy.audit.distortion.eps_angle) : shortfall()) +
-                                     "; now the model itself");
+      progress.stage("equalise", (copy.meets_contract() ? "the copy's map has eps_angle " + std::to_string(copy.audit.distortion.eps_angle) + "; "
+                                                         : shortfall()) +
+                                     "now the model itself");
     }
     run_pass(options, report["alignment"], "");
   }
