@@ -725,8 +725,16 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       progress.stage("equalise", (copy.meets_contract() ? "the copy's map has eps_angle " + std::to_string(copy.audit.distortion.eps_angle) + "; "
                                                          : shortfall()) +
                                      "now the model itself");
+      // The copy's map stands when the model's own pass fails (a model too thin for the quadtree).
+      try {
+        run_pass(options, report["alignment"], "");
+      } catch (const Error& e) {
+        progress.warning(std::string("the model itself: ") + e.what());
+        report["alignment"]["error"] = e.what();
+      }
+    } else {
+      run_pass(options, report["alignment"], "");
     }
-    run_pass(options, report["alignment"], "");
   }
   // Still short of the contract: everything once more with finer contours. Where the quadtree
   // drops a thin part of a cross-section (a tail, a horn, a hoof), P has nothing for it and the
@@ -801,6 +809,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   const auto finished_attempts = std::count_if(attempts.begin(), attempts.end(), [](const auto& a) { return a->finished != nullptr; });
   report["alignment"]["chosen"] = chosen.name;
   if (chosen.name != first_choice) progress.stage("retry", "kept " + chosen.name);
+  if (chosen.scaled() && chosen.finished && chosen.finished->audit.distortion.eps_angle > kEqualiseKeepAngle)
+    progress.warning("the map kept is the scaled copy's, far from conformal on the model (eps_angle " +
+                     std::to_string(chosen.finished->audit.distortion.eps_angle) + "): the model itself gave none better");
   if (finished_attempts > 1) {
     nlohmann::json finished = nlohmann::json::array();
     for (const std::unique_ptr<Attempt>& a : attempts) {

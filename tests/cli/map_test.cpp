@@ -548,6 +548,32 @@ TEST(MapCli, AVeryLongRodIsMappedThroughACopyScaledTowardsEqualSpreads) {
   EXPECT_LT(extent.minCoeff(), 0.002);
 }
 
+// sphere.off squashed to 1 : 10⁻³ : 10⁻³: no polycube of its own (its sections are finer than the
+// quadtree's cells; it failed with exit 6). Its scaled copy's map, far from conformal on the model
+// (ε_angle about 1 200), is kept when the model's own pass fails, and a warning says so.
+TEST(MapCli, TheScaledCopysMapStandsWhenTheModelHasNoPolycube) {
+  const std::string dir = test::temp_dir("map-needle");
+  TriMesh needle = test::load_test_mesh("sphere.off");
+  needle.V.col(1) *= 1e-3;
+  needle.V.col(2) *= 1e-3;
+  const std::string input = dir + "/needle.off";
+  write_mesh(input, needle);
+  const std::string out = dir + "/map";
+  const CliRun run = polycube_cli("map " + quoted(input) + " -o " + quoted(out));
+  ASSERT_EQ(run.code, 0) << run.err;
+  EXPECT_NE(run.err.find("warning: the model itself: no orientation gives a valid polycube"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("warning: the map kept is the scaled copy's, far from conformal"), std::string::npos) << run.err;
+  const nlohmann::json report = read_json(out + "/report.json");
+  EXPECT_TRUE(report.at("alignment").contains("error"));
+  EXPECT_TRUE(report.at("map").at("meets_contract").get<bool>());
+  EXPECT_GT(report.at("map").at("eps_angle").get<double>(), 1.1);
+  const TriMesh P = test::load_mesh_file(out + "/polycube.obj");
+  const MapAudit files = audit_map(needle, P, test::load_mesh_file(out + "/polycube_on_model.obj").V,
+                                   test::load_mesh_file(out + "/model_on_polycube.obj").V);
+  EXPECT_EQ(files.polycube_to_model.flipped + files.model_to_polycube.flipped, 0);
+  EXPECT_EQ(tilted_faces(out + "/polycube.obj", report_rotation(report)), 0);
+}
+
 // sphere.off (radius 0.5) moved to (1e7, -3e6, 5e6): before, no orientation gave a polycube (a
 // contour's area of absolute coordinates came out negative). The model is now moved to the origin
 // for the stages and every file goes back: the map meets its contract with its images round the
