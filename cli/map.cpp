@@ -38,15 +38,6 @@ namespace {
 // The stages `map` can stop after, in pipeline order. The default is the last one built.
 const std::vector<std::string> kStages = {"topology", "polycube", "map"};
 
-// --equalise-axes auto: the copy is made for a long model, whose largest principal standard
-// deviation exceeds the middle one this many times. The 20 shipped meshes reach 3.2 (femur) and
-// meet the contract on the model itself; a 40:2:3 needle is at 11.6, CAD rods 1000 and 3 333
-// times as long as wide at 411 and 1 369. Not for flat ones (a plate, a washer, a sheet: the two
-// largest alike): their own maps met the contract with lower ε_angle (plate 1 x 1 x 0.001: 1.000
-// against 1.082 through the copy; washer 1.032 against 1.186; sheet 1.014 against 1.043).
-constexpr double kEqualiseLength = 5;
-// Its axes are scaled so that their standard deviations are within this ratio of each other.
-constexpr double kEqualiseRatio = 4;
 // The copy's map is kept without a pass on the model itself when it meets the contract with
 // ε_angle at most this; otherwise the model's pass runs too and the better map by rank is kept.
 // The copy's map is finished on the model, but P's faces and the model's surface turn apart under
@@ -65,8 +56,8 @@ struct MapOptions {
   std::string stage = kStages.back();
   std::string align = "auto";
   std::string separate = "always";
-  // auto: a model much longer than wide (kEqualiseLength) is mapped first on a copy with its
-  // principal axes scaled to within kEqualiseRatio of each other (equalised_axes); never: on the
+  // auto: a model much longer than wide is mapped first on a copy with its principal axes scaled
+  // towards equal spreads (equalised_copy); never: on the
   // model as it is.
   std::string equalise_axes = "auto";
   int smooth_sweeps = 10;
@@ -420,42 +411,6 @@ std::unique_ptr<Finished> exact_map(const TriMesh& model, const Polycube& P, con
   return out;
 }
 
-// P built on a scaled copy (--equalise-axes), its coordinates divided by the copy's scales: an
-// axis-aligned scaling keeps its faces axis-aligned and its structure.
-Polycube unscaled_polycube(const Polycube& P, const Eigen::Vector3d& scales) {
-  Polycube out = P;
-  const Eigen::Vector3d inverse = scales.cwiseInverse();
-  out.mesh.V = P.mesh.V * inverse.asDiagonal();
-  for (PolycubeFace& f : out.faces) {
-    f.coordinate *= inverse(f.axis);
-    f.area *= inverse((f.axis + 1) % 3) * inverse((f.axis + 2) % 3);
-  }
-  for (std::vector<SectionPolygon>& plane : out.sections)
-    for (SectionPolygon& polygon : plane)
-      for (Eigen::Vector2d& q : polygon.points) q = q.cwiseProduct(inverse.head<2>());
-  for (double& z : out.levels) z *= inverse(2);
-  out.spacing = 0;
-  for (const PolycubeEdge& e : out.edges)
-    for (size_t k = 0; k + 1 < e.vertices.size(); ++k)
-      out.spacing = std::max(out.spacing, (out.mesh.V.row(e.vertices[k + 1]) - out.mesh.V.row(e.vertices[k])).norm());
-  return out;
-}
-
-// φ sampled at the vertices of both meshes, taken back the same way (surface points are
-// barycentric, so they stay). Without the copy's map data: what finishes a map needs only the
-// samples.
-PolycubeMap unscaled_map(const PolycubeMap& map, const Eigen::Vector3d& scales) {
-  PolycubeMap out;
-  out.polycube_on_model = map.polycube_on_model;
-  out.model_on_polycube = map.model_on_polycube;
-  out.polycube_on_model_xyz = map.polycube_on_model_xyz * scales.cwiseInverse().asDiagonal();
-  out.model_on_polycube_xyz = map.model_on_polycube_xyz * scales.cwiseInverse().asDiagonal();
-  out.pieces = map.pieces;
-  out.contours = map.contours;
-  out.seconds = map.seconds;
-  return out;
-}
-
 // The stages of one orientation that the search did not build (all of them with --align none),
 // up to the stage asked; with the map, its refinement and finish. P's sampling of φ is refined
 // where its chords flip or lose area (issue 5) before the smoothing (φ itself at the new
@@ -508,12 +463,12 @@ void run_stages(Attempt& a, const TriMesh& input, const MapOptions& options, con
       a.rotation = a.unscaled;
       for (double& z : planes_z) z /= a.scales(2);
       a.real_polycubes[0] = std::make_unique<Polycube>(unscaled_polycube(*unrefined_polycube, a.scales));
-      a.real_maps[0] = std::make_unique<PolycubeMap>(unscaled_map(*unrefined_map, a.scales));
+      a.real_maps[0] = std::make_unique<PolycubeMap>(unscaled_samples(*unrefined_map, a.scales));
       unrefined_polycube = a.real_polycubes[0].get();
       unrefined_map = a.real_maps[0].get();
       if (refined_polycube) {
         a.real_polycubes[1] = std::make_unique<Polycube>(unscaled_polycube(*refined_polycube, a.scales));
-        a.real_maps[1] = std::make_unique<PolycubeMap>(unscaled_map(*refined_map, a.scales));
+        a.real_maps[1] = std::make_unique<PolycubeMap>(unscaled_samples(*refined_map, a.scales));
         refined_polycube = a.real_polycubes[1].get();
         refined_map = a.real_maps[1].get();
       }
@@ -619,15 +574,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     return "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " + std::to_string(kept->finished->bad_m()) +
            " flipped, image area " + std::to_string(kept->finished->audit.polycube_to_model.area_ratio) + "; ";
   };
-  // A pass on the scaled copy (equalised_axes: source turned to its principal axes, then scaled)
-  // runs its stages on `copy`.
-  struct Equalised {
-    TriMesh copy;
-    Eigen::Matrix3d axes;
-    Eigen::Vector3d scales;
-  };
+  // A pass on a long model's scaled copy (equalised) runs its stages on the copy.
   auto run_pass = [&](const MapOptions& pass, nlohmann::json& alignment_report, const std::string& suffix,
-                      const Equalised* equalised = nullptr) {
+                      const EqualisedCopy* equalised = nullptr) {
     const TriMesh& stages_source = equalised ? equalised->copy : source;
     Alignment alignment;
     if (pass.align == "auto" && pass.stage != "topology") {
@@ -637,17 +586,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       AlignmentOptions align_options;
       if (kept) align_options.stop = time_limit.stop_for(progress);
       align_options.input_frame_only = equalised != nullptr;
-      if (equalised) align_options.axis_scales = equalised->scales;
-      alignment = choose_alignment(stages_source, pass.topology, pass.polycube, align_options);
       if (equalised) {
-        // The copy's frame is the model's principal axes, largest spread first.
-        const std::vector<std::pair<std::string, std::string>> names = {{"input frame, z up", "principal axes, least-spread axis up"},
-                                                                        {"input frame, x up", "principal axes, longest axis up"},
-                                                                        {"input frame, y up", "principal axes, middle axis up"}};
-        for (AlignmentCandidate& c : alignment.candidates)
-          for (const auto& [from, to] : names)
-            if (c.name.rfind(from, 0) == 0) c.name = to + c.name.substr(from.size());
+        align_options.axis_scales = equalised->scales;
+        align_options.input_frame_is_principal = true;
       }
+      alignment = choose_alignment(stages_source, pass.topology, pass.polycube, align_options);
       nlohmann::json candidates = nlohmann::json::array();
       for (const AlignmentCandidate& c : alignment.candidates)
         candidates.push_back({{"name", c.name}, {"corners", c.corners}, {"flipped", c.flipped}, {"eps_angle", c.eps_angle}, {"eps_area", c.eps_area},
@@ -698,22 +641,15 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (kept->finished->meets_contract()) return;
     }
   };
-  // A model much longer than wide: first on its scaled copy (kEqualiseLength); the
-  // model itself follows when that map misses the contract, is far from conformal
-  // (kEqualiseKeepAngle) or cannot be built, and the two compete by rank.
-  Eigen::Vector3d deviations, scales;
-  const Eigen::Matrix3d frame = equalised_axes(source, kEqualiseRatio, &deviations, &scales);
-  if (options.equalise_axes == "auto" && options.align == "auto" && runs(options.stage, "map") &&
-      deviations(0) > kEqualiseLength * deviations(1) && !frame.isIdentity(0)) {
-    Equalised equalised{rotated(source, frame), principal_axes(source), scales};
-    std::ostringstream said;
-    said << std::setprecision(3) << "principal deviations " << deviations(0) << ", " << deviations(1) << ", " << deviations(2)
-         << ": first on a copy with its axes scaled by " << scales(0) << ", " << scales(1) << ", " << scales(2);
-    progress.stage("equalise", said.str());
-    report["alignment"]["equalised"] = {{"deviations", {deviations(0), deviations(1), deviations(2)}},
-                                        {"scales", {scales(0), scales(1), scales(2)}}};
+  // A model much longer than wide: first on its scaled copy (equalised_copy); the model itself
+  // follows when that map misses the contract, is far from conformal (kEqualiseKeepAngle) or
+  // cannot be built, and the two compete by rank.
+  const std::optional<EqualisedCopy> equalised =
+      options.equalise_axes == "auto" && options.align == "auto" && runs(options.stage, "map") ? equalised_copy(source) : std::nullopt;
+  if (equalised) {
+    say_equalised_copy(*equalised, progress, report["alignment"]["equalised"]);
     try {
-      run_pass(options, report["alignment"]["equalised"], ", on a copy scaled along them", &equalised);
+      run_pass(options, report["alignment"]["equalised"], ", on a copy scaled along them", &*equalised);
     } catch (const Error& e) {
       progress.warning(std::string("the scaled copy: ") + e.what());
       report["alignment"]["equalised"]["error"] = e.what();
@@ -1014,7 +950,7 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "none"}));
   command->add_option("--equalise-axes", options->equalise_axes,
-                      "auto: a model far longer than wide (its largest principal deviation over 5 times the next) is mapped "
+                      "auto: a model far longer than wide (its largest principal deviation over 100 times the next) is mapped "
                       "first on a copy with its principal axes scaled to within 4 times of each other (P, built along them, "
                       "scaled back is still a polycube; the map is finished on the model); the model itself too when that map "
                       "misses the contract or has eps_angle above 1.1, the better kept; never: only the model itself. Only "

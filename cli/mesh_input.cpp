@@ -2,6 +2,9 @@
 
 #include "formats/mesh_io.h"
 
+#include <iomanip>
+#include <sstream>
+
 namespace polycube::cli {
 
 void add_mesh_input_options(CLI::App& command, MeshInput& input) {
@@ -37,6 +40,17 @@ std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, con
                           {"max_shift", s.max_shift},
                           {"seconds", s.seconds}};
   return s;
+}
+
+void say_equalised_copy(const EqualisedCopy& equalised, const Progress& progress, nlohmann::json& report) {
+  const Eigen::Vector3d& d = equalised.deviations;
+  const Eigen::Vector3d& s = equalised.scales;
+  std::ostringstream said;
+  said << std::setprecision(3) << "principal deviations " << d(0) << ", " << d(1) << ", " << d(2)
+       << ": first on a copy with its axes scaled by " << s(0) << ", " << s(1) << ", " << s(2);
+  progress.stage("equalise", said.str());
+  report["deviations"] = {d(0), d(1), d(2)};
+  report["scales"] = {s(0), s(1), s(2)};
 }
 
 Eigen::MatrixX3d placed_as_input(const PreparedMesh& prepared, Eigen::MatrixX3d V) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "cli/commands.h"
+#include "polycube/align.h"
 #include "polycube/separate.h"
 #include "polycube/validate.h"
 
@@ -27,6 +28,10 @@ PreparedMesh load_mesh(const MeshInput& input, const Progress& progress);
 // the stages that cut it by planes, said on stderr and in `report` ("separation"); nothing
 // otherwise. Results on the copy go back to the model with to_original_surface.
 std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report);
+
+// A long model's scaled copy (equalised_copy), said on stderr and in `report` (its deviations and
+// scales), before the search on it (`map`, `quad`).
+void say_equalised_copy(const EqualisedCopy& equalised, const Progress& progress, nlohmann::json& report);
 
 // Positions of the prepared mesh's frame in the input's: plus PreparedMesh::offset (a model far
 // from the origin is moved there by prepare_mesh; every file and coordinate written goes back).

@@ -51,6 +51,7 @@ struct QuadCommandOptions {
   std::string report_path;
   std::string preview_path;
   std::string align = "auto";
+  std::string equalise_axes = "auto";  // as `map --equalise-axes` (equalised_copy)
   std::string separate = "auto";
   int smooth_map_sweeps = 0;
   // Quads that still fall short are tried once more with d_a divided by this (as `map` does; a
@@ -220,7 +221,15 @@ struct QuadAttempt : AlignedStages {
   PolycubeOptions polycube_options;  // what its polycube is built with
   long long max_quads = 0;           // a larger grid gives the try up (0: the grid's default)
   std::string given_up;              // why it was given up (no result)
-  TriMesh aligned;  // the model turned by rotation
+  TriMesh aligned;  // the model turned by rotation (the scaled copy, when equalised)
+  // On a long model's scaled copy (equalised_copy, as `map`): topology, polycube and map built on
+  // the copy turned by rotation (x, y, z the model's turned by `unscaled`, times `scales`); the
+  // grid is laid on P scaled back (real_polycube) and carried by the copy's map, whose surface
+  // points are on the model's own faces.
+  const EqualisedCopy* equalised = nullptr;
+  Eigen::Vector3d scales = Eigen::Vector3d::Ones();
+  Eigen::Matrix3d unscaled = Eigen::Matrix3d::Identity();
+  std::unique_ptr<Polycube> real_polycube;
   std::optional<QuadRemeshResult> result;
   double smooth_map_seconds = 0, seconds = 0;
   int bad() const { return result->quality.flipped_quads + result->quality.degenerate_quads; }
@@ -366,7 +375,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // images are turned back into the input's frame. One search's candidates become attempts.
   // `stop` (AlignmentOptions::stop) can end the search: then it adds none and returns false.
   const auto add_attempts = [&](const PolycubeOptions& polycube, nlohmann::json& alignment_report, std::string suffix,
-                                const QuadModel& given, const std::function<bool()>& stop) {
+                                const QuadModel& given, const std::function<bool()>& stop, const EqualisedCopy* equalised = nullptr) {
     const QuadModel* on = &given;
     const TriMesh& model = *given.mesh;
     if (given.separation) suffix += ", separated copy";
@@ -375,12 +384,17 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       AlignmentOptions align_options;
       if (options.align == "corners") align_options.mapped_candidates = 0;
       align_options.stop = stop;
+      if (equalised) {
+        align_options.input_frame_only = true;
+        align_options.axis_scales = equalised->scales;
+        align_options.input_frame_is_principal = true;
+      }
       progress.stage("align", options.align == "auto"
                                   ? "orientations (input frame, principal axes, normal axes): polycubes, then maps of the 2 with fewest corners (the rest if both flip), scored by flips"
                                   : "orientations (input frame, principal axes, normal axes): the polycube with the fewest corners");
       const double align_start = progress.elapsed_seconds();
-      alignment = choose_alignment(model, options.topology, polycube, align_options);
-      if (!alignment.stopped && alignment.chosen < 0) {
+      alignment = choose_alignment(equalised ? equalised->copy : model, options.topology, polycube, align_options);
+      if (!alignment.stopped && alignment.chosen < 0 && !equalised) {
         on->no_polycube = true;
         if (const QuadModel* copy = separated_of(*on)) {
           progress.stage("align", "no orientation gives a valid polycube: the search again on the model's separated copy");
@@ -413,18 +427,27 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       attempts.back()->name = (stages.candidate >= 0 ? alignment.candidates[stages.candidate].name : std::string("input frame")) + suffix;
       attempts.back()->polycube_options = polycube;
       attempts.back()->on = on;
+      if (equalised) {
+        // The candidate's rotation only permutes the copy's axes (input frame only).
+        QuadAttempt& a = *attempts.back();
+        a.equalised = equalised;
+        a.scales = a.rotation.cwiseAbs() * equalised->scales;
+        a.unscaled = a.rotation * equalised->axes;
+      }
     }
     return true;
   };
-  if (options.map_dir.empty()) {
-    const QuadModel* copy = options.separate == "always" ? separated_of(split_model) : nullptr;
-    add_attempts(options.polycube, report["alignment"], "", copy ? *copy : split_model, {});
-  }
+  // The first search's model; a long one's scaled copy is searched before it (below).
+  const QuadModel* first_copy = options.map_dir.empty() && options.separate == "always" ? separated_of(split_model) : nullptr;
+  const QuadModel& first_model = first_copy ? *first_copy : split_model;
+  const std::optional<EqualisedCopy> equalised =
+      options.map_dir.empty() && options.equalise_axes == "auto" && options.align == "auto" ? equalised_copy(*first_model.mesh) : std::nullopt;
+  if (options.map_dir.empty() && !equalised) add_attempts(options.polycube, report["alignment"], "", first_model, {});
   // The map stages one orientation still needs, then its quads.
   bool placement_said = false;  // the copy's placement said once
   const auto remesh_with = [&](QuadAttempt& a) {
     const double start = progress.elapsed_seconds();
-    a.aligned = rotated(*a.on->mesh, a.rotation);
+    a.aligned = rotated(a.equalised ? a.equalised->copy : *a.on->mesh, a.rotation);
     const std::shared_ptr<const SurfaceProjector> projector = a.on->placement().projector();
     // A point of the map's mesh (input frame) at its place on the model the quads go on: itself,
     // or for a separated copy the same face and barycentric coordinates of the model (through
@@ -442,7 +465,11 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       };
     }
     progress.stage("topology", "harmonic function, critical points, cutting planes, slicing");
-    if (!a.topology) a.topology = std::make_shared<TopologyResult>(analyse_topology(a.aligned, options.topology));
+    if (!a.topology) {
+      TopologyOptions topology = options.topology;
+      topology.length_scales = a.scales;
+      a.topology = std::make_shared<TopologyResult>(analyse_topology(a.aligned, topology));
+    }
     progress.stage("polycube", "axis-aligned contours, stacking, triangulation, checks");
     if (!a.polycube) a.polycube = std::make_shared<PolycubeResult>(build_polycube(a.aligned, *a.topology, a.polycube_options));
     for (const std::string& repair : a.polycube->repairs) progress.warning("polycube: " + repair);
@@ -450,17 +477,26 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
                                    std::to_string(a.polycube->polycube.faces.size()) + " faces");
     progress.stage("map", "bijection between the polycube and the model");
     if (!a.map) a.map = std::make_shared<PolycubeMap>(build_polycube_map(a.aligned, *a.polycube));
-    const TriMesh& P = a.polycube->polycube.mesh;
+    if (a.equalised) a.real_polycube = std::make_unique<Polycube>(unscaled_polycube(a.polycube->polycube, a.scales));
+    const Polycube& grid_polycube = a.equalised ? *a.real_polycube : a.polycube->polycube;
+    const TriMesh& P = grid_polycube.mesh;
     SurfaceMap to_model;
-    if (options.smooth_map_sweeps > 0) {
+    // A scaled copy's map is smoothed on the model in any case (`map`'s 10 sweeps unless asked):
+    // scaled back unsmoothed, it shears where P's faces and the model's surface are not parallel
+    // (3 333 : 1 rod: 8.9° mean angle deviation, 1.3° through the smoothed map).
+    const int smooth_sweeps = options.smooth_map_sweeps > 0 ? options.smooth_map_sweeps : a.equalised ? 10 : 0;
+    if (smooth_sweeps > 0) {
       // The smoothed map (as `map` writes it): its images at P's vertices, interpolated in P's
       // triangles and placed on the model.
       progress.stage("smooth", "harmonic relaxation of the map, flips guarded");
       MapSmoothingOptions smooth_options;
-      smooth_options.sweeps = options.smooth_map_sweeps;
-      const MapSmoothingResult smoothed = smooth_map(a.aligned, a.polycube->polycube, *a.map, smooth_options);
+      smooth_options.sweeps = smooth_sweeps;
+      // (A scaled copy's map smoothed on the model turned by `unscaled`, as `map` finishes it.)
+      const MapSmoothingResult smoothed =
+          a.equalised ? smooth_map(rotated(*a.on->mesh, a.unscaled), grid_polycube, unscaled_samples(*a.map, a.scales), smooth_options)
+                      : smooth_map(a.aligned, a.polycube->polycube, *a.map, smooth_options);
       a.smooth_map_seconds = smoothed.seconds;
-      Eigen::MatrixX3d images = smoothed.polycube_on_model_xyz * a.rotation;
+      Eigen::MatrixX3d images = smoothed.polycube_on_model_xyz * (a.equalised ? a.unscaled : a.rotation);
       if (to_placement)
         for (int v = 0; v < images.rows(); ++v) images.row(v) = to_placement(images.row(v).transpose()).transpose();
       to_model = projected_map(vertex_image_map(P, images), projector);
@@ -472,6 +508,13 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
         // The copy as read has the model's faces: the map's surface points are the model's.
         const TriMesh& model = prepared.mesh;
         to_model = [&model, &map](const SurfacePoint& p) -> Eigen::Vector3d { return surface_position(model, map.to_model(p)); };
+      } else if (a.equalised) {
+        // The copy's faces are the model's.
+        const TriMesh& model = *a.on->mesh;
+        to_model = [&model, &map, to_placement](const SurfacePoint& p) -> Eigen::Vector3d {
+          const Eigen::Vector3d x = surface_position(model, map.to_model(p));
+          return to_placement ? to_placement(x) : x;
+        };
       } else {
         to_model = [&aligned, &map, rotation, to_placement](const SurfacePoint& p) -> Eigen::Vector3d {
           const Eigen::Vector3d x = rotation.transpose() * surface_position(aligned, map.to_model(p));
@@ -518,7 +561,31 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       if (!kept->worth_retrying()) break;
     }
   };
-  remesh_from(0);
+  if (equalised) {
+    // A long model: its scaled copy's tries first; the model's own search only when they fall
+    // short (its tries then capped as every try after the first), and the better quads kept.
+    say_equalised_copy(*equalised, progress, report["alignment"]["equalised"]);
+    try {
+      add_attempts(options.polycube, report["alignment"]["equalised"], ", on a copy scaled along them", first_model, {}, &*equalised);
+      remesh_from(0);
+    } catch (const Error& e) {
+      progress.warning(std::string("the scaled copy: ") + e.what());
+      report["alignment"]["equalised"]["error"] = e.what();
+    }
+    if (!kept || kept->worth_retrying() || kept->more_than(most_quads)) {
+      if (kept) progress.stage("retry", shortfall() + "now the model itself");
+      const size_t first = attempts.size();
+      try {
+        add_attempts(options.polycube, report["alignment"], "", first_model, {});
+        remesh_from(first);
+      } catch (const Error& e) {
+        if (!kept) throw;
+        progress.warning(std::string("the model itself: ") + e.what());
+      }
+    }
+  } else {
+    remesh_from(0);
+  }
   // Another search for quads still short, with other polycube options. A finer P's layout can
   // need many more quads than asked (spool: 104 368 for 10 000, at 0.538 % against 0.705 %, 4
   // minutes): its tries are capped as every try after the first (add_attempts).
@@ -643,7 +710,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     seconds["topology"] = kept->topology->seconds_total;
     seconds["polycube"] = kept->polycube->seconds_total;
     seconds["map"] = kept->map->seconds;
-    if (options.smooth_map_sweeps > 0) seconds["smooth_map"] = kept->smooth_map_seconds;
+    if (kept->smooth_map_seconds > 0) seconds["smooth_map"] = kept->smooth_map_seconds;
   }
   const QuadRemeshResult& result = *kept->result;
   const QuadQuality& q = result.quality;
@@ -815,6 +882,12 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
                       "corners: fewest polycube corners only (no candidate maps, faster); none: the input's orientation")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "corners", "none"}));
+  command->add_option("--equalise-axes", options->equalise_axes,
+                      "As for `map` (not with --map): auto: a model far longer than wide is searched first on a copy with its "
+                      "principal axes scaled to within 4 times of each other, the model itself when those quads fall short; "
+                      "never: the model itself only")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "never"}));
   command->add_option("--separate", options->separate,
                       "A model that intersects itself (not with --map): never: the model only; auto: when none of its orientations "
                       "gives a polycube, that search and the later ones on that model run on a copy pulled apart round the crossings "

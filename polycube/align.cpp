@@ -86,6 +86,46 @@ Eigen::Matrix3d equalised_axes(const TriMesh& mesh, double max_ratio, Eigen::Vec
   return s.asDiagonal() * axes;
 }
 
+std::optional<EqualisedCopy> equalised_copy(const TriMesh& model, const EqualisedCopyOptions& options) {
+  EqualisedCopy out;
+  const Eigen::Matrix3d frame = equalised_axes(model, options.max_ratio, &out.deviations, &out.scales);
+  if (!(out.deviations(0) > options.long_ratio * out.deviations(1)) || frame.isIdentity(0)) return std::nullopt;
+  out.axes = principal_axes(model);
+  out.copy = rotated(model, frame);
+  return out;
+}
+
+Polycube unscaled_polycube(const Polycube& P, const Eigen::Vector3d& scales) {
+  Polycube out = P;
+  const Eigen::Vector3d inverse = scales.cwiseInverse();
+  out.mesh.V = P.mesh.V * inverse.asDiagonal();
+  for (PolycubeFace& f : out.faces) {
+    f.coordinate *= inverse(f.axis);
+    f.area *= inverse((f.axis + 1) % 3) * inverse((f.axis + 2) % 3);
+  }
+  for (std::vector<SectionPolygon>& plane : out.sections)
+    for (SectionPolygon& polygon : plane)
+      for (Eigen::Vector2d& q : polygon.points) q = q.cwiseProduct(inverse.head<2>());
+  for (double& z : out.levels) z *= inverse(2);
+  out.spacing = 0;
+  for (const PolycubeEdge& e : out.edges)
+    for (size_t k = 0; k + 1 < e.vertices.size(); ++k)
+      out.spacing = std::max(out.spacing, (out.mesh.V.row(e.vertices[k + 1]) - out.mesh.V.row(e.vertices[k])).norm());
+  return out;
+}
+
+PolycubeMap unscaled_samples(const PolycubeMap& map, const Eigen::Vector3d& scales) {
+  PolycubeMap out;
+  out.polycube_on_model = map.polycube_on_model;
+  out.model_on_polycube = map.model_on_polycube;
+  out.polycube_on_model_xyz = map.polycube_on_model_xyz * scales.cwiseInverse().asDiagonal();
+  out.model_on_polycube_xyz = map.model_on_polycube_xyz * scales.cwiseInverse().asDiagonal();
+  out.pieces = map.pieces;
+  out.contours = map.contours;
+  out.seconds = map.seconds;
+  return out;
+}
+
 Eigen::Matrix3d normal_axes(const TriMesh& mesh, int max_faces, double* misalignment) {
   std::vector<Eigen::Vector3d> normals;
   std::vector<double> areas;
@@ -255,7 +295,8 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   auto add_frame = [&](int frame) {
     for (int k = 0; k < 3; ++k) {
       AlignmentCandidate c;
-      c.name = frame == 0 ? input_names[k] : frame == 1 ? principal_names[k] : normal_names[k];
+      c.name = frame == 0 ? (options.input_frame_is_principal ? principal_names[k] : input_names[k])
+                          : frame == 1 ? principal_names[k] : normal_names[k];
       c.rotation = cycles[k] * (frame == 0 ? Eigen::Matrix3d::Identity() : frame == 1 ? pca : normals);
       out.candidates.push_back(c);
     }

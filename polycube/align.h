@@ -21,6 +21,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,42 @@ Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread = nullptr);
 Eigen::Matrix3d equalised_axes(const TriMesh& mesh, double max_ratio, Eigen::Vector3d* deviations = nullptr,
                                Eigen::Vector3d* scales = nullptr);
 
+// A long model's scaled copy (map and quad --equalise-axes): the model turned to its principal
+// axes and scaled by equalised_axes(model, max_ratio), made when the largest principal standard
+// deviation exceeds the next long_ratio times. Defaults measured (bench/map.md, thirty-fourth
+// session): CAD rods 1000 and 3 333 times as long as wide (ratios 411 and 1 369) need it (the
+// latter's own map did not finish in 26 minutes, the former's quads took 404 s); below 100 the
+// model's own maps and quads were as good or better: a 100 : 1 rod (41) ε_angle 1.032 against
+// 1.043 through the copy, quads 1.8° against 5.3°; a 40:2:3 needle (11.6) 1.034 against 1.021; the
+// 20 shipped meshes reach 3.2 (femur). Flat models (the two largest deviations alike) are never
+// long: plates, a washer and a sheet had less conformal maps through a copy.
+//   copy        rotated(model, scales.asDiagonal() * axes)
+//   axes        principal_axes(model)
+//   scales      the copy's x, y, z are the model's along axes times these
+//   deviations  the model's standard deviations along axes
+struct EqualisedCopy {
+  TriMesh copy;
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d scales = Eigen::Vector3d::Ones(), deviations = Eigen::Vector3d::Zero();
+};
+struct EqualisedCopyOptions {
+  double long_ratio = 100;
+  double max_ratio = 4;
+};
+std::optional<EqualisedCopy> equalised_copy(const TriMesh& model, const EqualisedCopyOptions& options = {});
+
+// P built on a scaled copy turned by a permutation of its axes (its x, y, z the model's turned
+// frame's times scales), its coordinates divided by the scales: an axis-aligned scaling keeps its
+// faces axis-aligned and its structure (faces' coordinates and areas, sections, levels and
+// spacing follow).
+Polycube unscaled_polycube(const Polycube& P, const Eigen::Vector3d& scales);
+
+// φ sampled at the vertices of both meshes, taken back the same way: the surface points are
+// barycentric, so they stay; the positions are divided. Without the copy's map data (disks and
+// locators are the copy's): what finishes a map (smoothing, the second refinement, the audit)
+// needs only the samples.
+PolycubeMap unscaled_samples(const PolycubeMap& map, const Eigen::Vector3d& scales);
+
 // The frame whose axes the surface normals align with best, as the rows of a proper rotation: the
 // minimiser of Σ_f area_f (x²y² + y²z² + z²x²) over the faces' unit normals (x, y, z) in that
 // frame, which is 0 exactly when every face is perpendicular to an axis (a CAD part in its own
@@ -147,6 +184,9 @@ struct AlignmentOptions {
   // The mesh is a copy whose x, y, z are a model's times these (with input_frame_only): each
   // candidate's girth rule measures on the model (TopologyOptions::length_scales).
   Eigen::Vector3d axis_scales = Eigen::Vector3d::Ones();
+  // The input frame is the model's principal axes (an equalised copy's): its candidates are named
+  // as the principal axes' ("principal axes, longest axis up").
+  bool input_frame_is_principal = false;
   // How many candidates (fewest corners first) get their map built and audited first; if all of
   // those still have flipped triangles, the rest are mapped too. 0: corners only.
   int mapped_candidates = 2;
