@@ -780,6 +780,12 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   };
   const TopologyResult& topology = *chosen.topology;
   report["topology"] = topology_json(topology);
+  // A scaled copy's heights, in the turned frame (divided by its z scale).
+  const auto turned_heights = [&chosen](std::vector<double> z) {
+    for (double& h : z) h /= chosen.scales(2);
+    return z;
+  };
+  if (chosen.scaled()) report["topology"]["cutting_planes"] = turned_heights(topology.planes_z);
   nlohmann::json seconds = {{"align", align_seconds}, {"topology", topology.seconds_total}};
   if (finished_attempts > 1) {
     double retry_seconds = 0;
@@ -796,11 +802,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   if (polycube) {
     model_pieces = &polycube->model_sliced;
     report["polycube"] = polycube_json(*polycube);
-    if (chosen.scaled()) {
-      std::vector<double> planes = polycube->planes_z;
-      for (double& z : planes) z /= chosen.scales(2);
-      report["polycube"]["planes"] = planes;
-    }
+    if (chosen.scaled()) report["polycube"]["planes"] = turned_heights(polycube->planes_z);
     report["polycube"]["da"] = chosen.da;
     seconds["polycube"] = polycube->seconds_total;
     written_polycube = &polycube->polycube;
