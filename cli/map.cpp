@@ -622,8 +622,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (equalised) {
         // The candidate's rotation only permutes the copy's axes (input frame only).
         Attempt& a = *attempts.back();
-        a.scales = a.rotation.cwiseAbs() * equalised->scales;
-        a.unscaled = a.rotation * equalised->axes;
+        a.scales = equalised->turned_scales(a.rotation);
+        a.unscaled = equalised->turned_axes(a.rotation);
         a.unscaled_source = &source;
       }
     }

@@ -431,8 +431,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
         // The candidate's rotation only permutes the copy's axes (input frame only).
         QuadAttempt& a = *attempts.back();
         a.equalised = equalised;
-        a.scales = a.rotation.cwiseAbs() * equalised->scales;
-        a.unscaled = a.rotation * equalised->axes;
+        a.scales = equalised->turned_scales(a.rotation);
+        a.unscaled = equalised->turned_axes(a.rotation);
       }
     }
     return true;

@@ -71,27 +71,17 @@ Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread, Eigen::Vecto
 
 Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread) { return principal_axes(mesh, spread, nullptr); }
 
-Eigen::Matrix3d equalised_axes(const TriMesh& mesh, double max_ratio, Eigen::Vector3d* deviations, Eigen::Vector3d* scales) {
-  Eigen::Vector3d variances;
-  const Eigen::Matrix3d axes = principal_axes(mesh, nullptr, &variances);
-  const Eigen::Vector3d sigma = variances.cwiseMax(0).cwiseSqrt();
-  if (deviations) *deviations = sigma;
-  if (scales) *scales = Eigen::Vector3d::Ones();
-  if (!(sigma.minCoeff() > 0) || !(sigma.maxCoeff() > max_ratio * sigma.minCoeff())) return Eigen::Matrix3d::Identity();
-  const double mean = std::cbrt(sigma.prod()), band = std::sqrt(max_ratio);
-  Eigen::Vector3d s;
-  for (int i = 0; i < 3; ++i) s(i) = std::clamp(sigma(i), mean / band, mean * band) / sigma(i);
-  s /= std::cbrt(s.prod());
-  if (scales) *scales = s;
-  return s.asDiagonal() * axes;
-}
-
 std::optional<EqualisedCopy> equalised_copy(const TriMesh& model, const EqualisedCopyOptions& options) {
   EqualisedCopy out;
-  const Eigen::Matrix3d frame = equalised_axes(model, options.max_ratio, &out.deviations, &out.scales);
-  if (!(out.deviations(0) > options.long_ratio * out.deviations(1)) || frame.isIdentity(0)) return std::nullopt;
-  out.axes = principal_axes(model);
-  out.copy = rotated(model, frame);
+  Eigen::Vector3d variances;
+  out.axes = principal_axes(model, nullptr, &variances);
+  const Eigen::Vector3d& sigma = out.deviations = variances.cwiseMax(0).cwiseSqrt();
+  if (!(sigma(0) > options.long_ratio * sigma(1)) || !(sigma.minCoeff() > 0) || !(sigma.maxCoeff() > options.max_ratio * sigma.minCoeff()))
+    return std::nullopt;
+  const double mean = std::cbrt(sigma.prod()), band = std::sqrt(options.max_ratio);
+  for (int i = 0; i < 3; ++i) out.scales(i) = std::clamp(sigma(i), mean / band, mean * band) / sigma(i);
+  out.scales /= std::cbrt(out.scales.prod());
+  out.copy = rotated(model, out.scales.asDiagonal() * out.axes);
   return out;
 }
 
@@ -259,7 +249,7 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   const auto turned_topology = [&](const Eigen::Matrix3d& rotation) {
     TopologyOptions turned = topology;
     // (Only the input frame's axes, permuted, are candidates then.)
-    if (options.axis_scales != Eigen::Vector3d::Ones()) turned.length_scales = rotation.cwiseAbs() * options.axis_scales;
+    if (options.axis_scales != Eigen::Vector3d::Ones()) turned.length_scales = rotation.cwiseAbs() * options.axis_scales;  // as EqualisedCopy::turned_scales
     return turned;
   };
   double spread = 1;

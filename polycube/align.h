@@ -90,21 +90,13 @@ struct Alignment {
 // whose principal axes are any axes: rounding picks them).
 Eigen::Matrix3d principal_axes(const TriMesh& mesh, double* spread = nullptr);
 
-// The frame a very long model is first mapped in (map --equalise-axes): its principal axes (the
-// rows of principal_axes), each scaled so that the surface's standard deviations along them come
-// within max_ratio of each other (those beyond the geometric mean's band, sqrt(max_ratio) either
-// way, are brought to its edge; the scales' product is 1). A copy turned by it (rotated(mesh,
-// frame): V * frame^T) is a linear image of the model, and scaling along the axes keeps a
-// polycube built in the copy's frame axis-aligned: the copy's P, scaled back, is a polycube of the
-// model. deviations (optional): the model's standard deviations along the axes, largest first.
-// scales (optional): the three factors, row by row. The identity, unscaled, when every ratio is
-// within max_ratio.
-Eigen::Matrix3d equalised_axes(const TriMesh& mesh, double max_ratio, Eigen::Vector3d* deviations = nullptr,
-                               Eigen::Vector3d* scales = nullptr);
-
 // A long model's scaled copy (map and quad --equalise-axes): the model turned to its principal
-// axes and scaled by equalised_axes(model, max_ratio), made when the largest principal standard
-// deviation exceeds the next long_ratio times. Defaults measured (bench/map.md, thirty-fourth
+// axes (the rows of principal_axes), each scaled so that the surface's standard deviations along
+// them come within max_ratio of each other (those beyond the geometric mean's band,
+// sqrt(max_ratio) either way, are brought to its edge; the scales' product is 1). It is a linear
+// image of the model, and scaling along the axes keeps a polycube built in the copy's frame
+// axis-aligned: the copy's P, scaled back, is a polycube of the model. Made when the largest
+// principal standard deviation exceeds the next long_ratio times. Defaults measured (bench/map.md, thirty-fourth
 // session): CAD rods 1000 and 3 333 times as long as wide (ratios 411 and 1 369) need it (the
 // latter's own map did not finish in 26 minutes, the former's quads took 404 s); below 100 the
 // model's own maps and quads were as good or better: a 100 : 1 rod (41) ε_angle 1.032 against
@@ -119,6 +111,11 @@ struct EqualisedCopy {
   TriMesh copy;
   Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
   Eigen::Vector3d scales = Eigen::Vector3d::Ones(), deviations = Eigen::Vector3d::Zero();
+  // For a candidate turning the copy by `rotation` (a permutation of its axes: input_frame_only):
+  // the scales of the turned copy's x, y, z, and the rotation turning the model into that frame
+  // unscaled (turned copy = turned model times turned_scales).
+  Eigen::Vector3d turned_scales(const Eigen::Matrix3d& rotation) const { return rotation.cwiseAbs() * scales; }
+  Eigen::Matrix3d turned_axes(const Eigen::Matrix3d& rotation) const { return rotation * axes; }
 };
 struct EqualisedCopyOptions {
   double long_ratio = 100;
@@ -179,7 +176,7 @@ struct AlignmentOptions {
   // same (bench/map.md, thirty-first session). 0: no limit.
   double max_fallback_rasterized_cells = 5e8;
   // Only the input frame's three axes are candidates, in the fallbacks too (a copy whose own frame
-  // must be kept: one scaled along its axes, equalised_axes).
+  // must be kept: one scaled along its axes, equalised_copy).
   bool input_frame_only = false;
   // The mesh is a copy whose x, y, z are a model's times these (with input_frame_only): each
   // candidate's girth rule measures on the model (TopologyOptions::length_scales).

@@ -40,32 +40,36 @@ TEST(Align, PrincipalAxesOfATurnedBoxAreItsEdges) {
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(std::abs(axes.row(i).dot(turn.col(i))), 1.0, 1e-9) << "axis " << i;
 }
 
-// A rod 1000 times as long as wide, turned: its principal axes scaled so that the spreads along
-// them come within the ratio asked (the longest shrunk, the others grown, volume kept); a model
-// already within it is left as it is.
-TEST(Align, EqualisedAxesBringTheSpreadsWithinTheRatio) {
+// A rod 1000 times as long as wide, turned: its copy has the principal axes scaled so that the
+// spreads along them come within the ratio asked (the longest shrunk, the others grown, volume
+// kept); a model not that long gets none.
+TEST(Align, AnEqualisedCopyBringsTheSpreadsWithinTheRatio) {
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, -2, 1).normalized()).toRotationMatrix();
   const TriMesh rod = rotated(test::make_rod(0.001, 1, 24), turn);
-  Eigen::Vector3d deviations, scales;
-  const Eigen::Matrix3d frame = equalised_axes(rod, 4, &deviations, &scales);
-  EXPECT_GT(deviations(0), 300 * deviations(1));
-  EXPECT_NEAR(deviations(1), deviations(2), 1e-3 * deviations(1));
-  EXPECT_NEAR(scales.prod(), 1.0, 1e-12);
-  EXPECT_LT(scales(0), 1);
-  EXPECT_GT(scales(2), 1);
-  // The rows are principal_axes' rows times the scales.
-  const Eigen::Matrix3d axes = principal_axes(rod);
-  for (int i = 0; i < 3; ++i) EXPECT_LT((frame.row(i) - scales(i) * axes.row(i)).norm(), 1e-12) << "row " << i;
-  // The copy's own standard deviations are about 4 apart: the ratio, but its caps weigh more
-  // against its sides once scaled (the surface's measure is not carried linearly).
+  const std::optional<EqualisedCopy> e = equalised_copy(rod);
+  ASSERT_TRUE(e);
+  EXPECT_GT(e->deviations(0), 300 * e->deviations(1));
+  EXPECT_NEAR(e->deviations(1), e->deviations(2), 1e-3 * e->deviations(1));
+  EXPECT_NEAR(e->scales.prod(), 1.0, 1e-12);
+  EXPECT_LT(e->scales(0), 1);
+  EXPECT_GT(e->scales(2), 1);
+  EXPECT_LT((e->axes - principal_axes(rod)).norm(), 1e-15);
+  // The copy is the rod turned by the axes and scaled along them.
+  EXPECT_LT((e->copy.V - rotated(rod, e->scales.asDiagonal() * e->axes).V).norm(), 1e-15);
+  // Its own standard deviations are about 4 apart: the ratio, but its caps weigh more against its
+  // sides once scaled (the surface's measure is not carried linearly).
   double copy_spread = 0;
-  principal_axes(rotated(rod, frame), &copy_spread);
+  principal_axes(e->copy, &copy_spread);
   EXPECT_GT(copy_spread, 16 * 0.9);
   EXPECT_LT(copy_spread, 25);
+  // Turned by a candidate (x up: a cyclic permutation), the copy's scales and the model's rotation
+  // follow the axes.
+  const Eigen::Matrix3d x_up = (Eigen::Matrix3d() << 0, 1, 0, 0, 0, 1, 1, 0, 0).finished();
+  EXPECT_EQ(e->turned_scales(x_up), Eigen::Vector3d(e->scales(1), e->scales(2), e->scales(0)));
+  EXPECT_LT((rotated(rotated(rod, e->turned_axes(x_up)), e->turned_scales(x_up).asDiagonal()).V - rotated(e->copy, x_up).V).norm(), 1e-12);
 
-  Eigen::Vector3d none;
-  EXPECT_TRUE(equalised_axes(test::make_sphere(2), 4, nullptr, &none).isIdentity(0));
-  EXPECT_EQ(none, Eigen::Vector3d::Ones());
+  EXPECT_FALSE(equalised_copy(test::make_sphere(2)));
+  EXPECT_FALSE(equalised_copy(test::make_rod(0.01, 1, 24)));  // 100 : 1, a deviation ratio of 41
 }
 
 TEST(Align, AlignedModelsAreNotTilted) {
