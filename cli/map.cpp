@@ -58,8 +58,7 @@ struct MapOptions {
   std::string align = "auto";
   std::string separate = "always";
   // auto: a model much longer than wide is mapped first on a copy with its principal axes scaled
-  // towards equal spreads (equalised_copy); never: on the
-  // model as it is.
+  // towards equal spreads (equalised_copy); never: on the model as it is.
   std::string equalise_axes = "auto";
   int smooth_sweeps = 10;
   bool refine = true;
