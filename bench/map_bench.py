@@ -66,8 +66,9 @@ def run_command(command, mesh, report_path):
 
 
 def run(binary, mesh, extra):
-    out = tempfile.mkdtemp(prefix="polycube-bench-")
-    return run_command([binary, "map", mesh, "-o", out, "--quiet"] + extra, mesh, os.path.join(out, "report.json"))
+    # The files are read back into the report and removed with their directory.
+    with tempfile.TemporaryDirectory(prefix="polycube-bench-") as out:
+        return run_command([binary, "map", mesh, "-o", out, "--quiet"] + extra, mesh, os.path.join(out, "report.json"))
 
 
 def main():

@@ -22,10 +22,11 @@ from map_bench import ROOT, default_meshes, run_command
 
 
 def run(binary, mesh, extra):
-    out = tempfile.mkdtemp(prefix="polycube-quad-bench-")
-    report_path = os.path.join(out, "report.json")
-    return run_command([binary, "quad", mesh, "-o", os.path.join(out, "quads.obj"), "--report", report_path, "--quiet"] + extra,
-                       mesh, report_path)
+    # The report is read back and the directory removed with the quads.
+    with tempfile.TemporaryDirectory(prefix="polycube-quad-bench-") as out:
+        report_path = os.path.join(out, "report.json")
+        return run_command([binary, "quad", mesh, "-o", os.path.join(out, "quads.obj"), "--report", report_path, "--quiet"] + extra,
+                           mesh, report_path)
 
 
 def mended(r, what):

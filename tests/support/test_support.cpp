@@ -17,6 +17,7 @@
 #include <mutex>
 #include <random>
 #include <sstream>
+#include <vector>
 
 namespace polycube::test {
 
@@ -68,12 +69,39 @@ std::string example_path(const std::string& name) { return std::string(POLYCUBE_
 
 std::string binary_path() { return POLYCUBE_BINARY; }
 
+namespace {
+
+// The directories temp_dir made, removed when the test process exits normally (each ctest test is
+// its own process), unless POLYCUBE_KEEP_TEST_FILES is set. A crashed test leaves its own.
+class TempDirs {
+ public:
+  ~TempDirs() {
+    if (std::getenv("POLYCUBE_KEEP_TEST_FILES")) return;
+    for (const std::filesystem::path& dir : dirs_) {
+      std::error_code ignored;  // a test that took its own directory's permissions away keeps it
+      std::filesystem::remove_all(dir, ignored);
+    }
+  }
+  void add(const std::filesystem::path& dir) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    dirs_.push_back(dir);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::filesystem::path> dirs_;
+};
+
+}  // namespace
+
 std::string temp_dir(const std::string& tag) {
   static std::atomic<int> counter{0};
+  static TempDirs made;
   std::random_device rd;
   const auto dir = std::filesystem::temp_directory_path() /
                    ("polycube-test-" + tag + "-" + std::to_string(rd()) + "-" + std::to_string(counter++));
   std::filesystem::create_directories(dir);
+  made.add(dir);
   return dir.string();
 }
 

@@ -45,7 +45,8 @@ std::string example_path(const std::string& name);
 // Absolute path of the built `polycube` binary.
 std::string binary_path();
 
-// A fresh empty directory under the system temp dir, removed by nobody (ctest runs are short).
+// A fresh empty directory under the system temp dir, removed with everything in it when the test
+// process exits (kept when the environment variable POLYCUBE_KEEP_TEST_FILES is set).
 std::string temp_dir(const std::string& tag);
 
 // Whole contents of a file (binary); empty when it cannot be read.
