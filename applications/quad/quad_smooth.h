@@ -164,6 +164,12 @@ struct QuadUntangleOptions {
   int passes = 10;
   int rings = 2;
   int patch_rings = 6;  // 0: no patches
+  // A patch with more quads than this is not tried (0: no limit). A regular grid's patch of 6
+  // rings has 169 quads, a round one of radius 6 about 113; the largest tried on anchor and elk
+  // had 277 and 544. Where a layout is all slivers (femur through a map whose P has 2 952
+  // corners: 224 528 quads, each a layout cell of its own), round patches reached 41 665 quads
+  // and the patches of 231 flipped quads did not end in 10 minutes.
+  int max_patch_quads = 5000;
   // Collapsed quads count as bad (false: flipped ones only).
   bool collapsed = true;
   // Quads with an inverted corner (non-convex or folded at a corner) are worked on too: their
@@ -189,7 +195,8 @@ struct QuadUntangleResult {
 };
 
 // pinned (empty, or one flag per vertex): vertices that do not move.
-// Throws std::invalid_argument for negative passes, rings or patch_rings, or pinned flags of the wrong size.
+// Throws std::invalid_argument for negative passes, rings, patch_rings or max_patch_quads, or pinned flags of
+// the wrong size.
 QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadUntangleOptions& options = {},
                                   const std::vector<char>& pinned = {});
 

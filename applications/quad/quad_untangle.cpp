@@ -33,9 +33,10 @@ std::map<std::pair<int, int>, int> directed_edges(const Eigen::MatrixX4i& Q, con
 // when radius is 0, else those reached from it through shared vertices whose centres lie within
 // `radius` of its centre. Then, a few times, the quads round each vertex where the patch touches
 // itself (two of its boundary edges leave the vertex) join it, then the quads round the vertices
-// of its holes (every boundary loop but the longest).
+// of its holes (every boundary loop but the longest). Empty when it would have more than
+// max_quads quads (0: no limit).
 std::vector<int> patch_round(const QuadMesh& mesh, const std::vector<std::vector<int>>& around, int seed, int rings,
-                             double radius) {
+                             double radius, int max_quads) {
   const Eigen::MatrixX4i& Q = mesh.Q;
   const auto centre = [&](int q) {
     return Eigen::Vector3d((mesh.V.row(Q(q, 0)) + mesh.V.row(Q(q, 1)) + mesh.V.row(Q(q, 2)) + mesh.V.row(Q(q, 3))) / 4);
@@ -55,6 +56,7 @@ std::vector<int> patch_round(const QuadMesh& mesh, const std::vector<std::vector
             in_patch[q] = 1;
             patch.push_back(q);
           }
+    if (max_quads > 0 && static_cast<int>(patch.size()) > max_quads) return {};
     ring_start = ring_end;
   }
   for (int round = 0; round < 6; ++round) {
@@ -98,6 +100,7 @@ std::vector<int> patch_round(const QuadMesh& mesh, const std::vector<std::vector
     }
     if (!grew) break;
   }
+  if (max_quads > 0 && static_cast<int>(patch.size()) > max_quads) return {};
   return patch;
 }
 
@@ -263,9 +266,10 @@ class PatchEmbedder {
 QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector& surface, const QuadUntangleOptions& options,
                                   const std::vector<char>& pinned) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.passes < 0 || options.rings < 0 || options.patch_rings < 0)
-    throw std::invalid_argument("untangling passes, rings and patch rings must be >= 0, got " + std::to_string(options.passes) +
-                                ", " + std::to_string(options.rings) + " and " + std::to_string(options.patch_rings));
+  if (options.passes < 0 || options.rings < 0 || options.patch_rings < 0 || options.max_patch_quads < 0)
+    throw std::invalid_argument("untangling passes, rings, patch rings and patch quads must be >= 0, got " +
+                                std::to_string(options.passes) + ", " + std::to_string(options.rings) + ", " +
+                                std::to_string(options.patch_rings) + " and " + std::to_string(options.max_patch_quads));
   if (!pinned.empty() && static_cast<int>(pinned.size()) != quads.num_vertices())
     throw std::invalid_argument("untangling: " + std::to_string(pinned.size()) + " pinned flags for " +
                                 std::to_string(quads.num_vertices()) + " vertices");
@@ -422,7 +426,8 @@ QuadUntangleResult untangle_quads(const QuadMesh& quads, const SurfaceProjector&
       // long and thin, and rings of them make a ragged patch).
       for (int attempt = 0; attempt < 2 * options.patch_rings; ++attempt) {
         const int rings = attempt / 2 + 1;
-        const std::vector<int> patch = patch_round(mesh, around, q, rings, attempt % 2 ? rings * size : 0.0);
+        const std::vector<int> patch = patch_round(mesh, around, q, rings, attempt % 2 ? rings * size : 0.0, options.max_patch_quads);
+        if (patch.empty()) continue;  // larger than max_patch_quads
         std::vector<Badness> was;
         for (int p : patch) was.push_back(state[p]);
         std::vector<std::pair<int, Eigen::Vector3d>> old_positions;

@@ -339,8 +339,18 @@ TEST(QuadUntangle, LaysOutAMirroredPatchAgain) {
       EXPECT_EQ(r.mesh.V.row(v), grid.V.row(v)) << "the grid's rim stays";
     }
   }
+  // Patches larger than max_patch_quads are not tried: with room for fewer quads than the
+  // mirrored block has, no patch can turn it back.
+  QuadUntangleOptions small_patches;
+  small_patches.max_patch_quads = 8;
+  const QuadUntangleResult capped = untangle_quads(grid, top, small_patches);
+  EXPECT_EQ(capped.patches, 0);
+  EXPECT_GT(capped.flipped_after, 0);
   QuadUntangleOptions bad;
   bad.patch_rings = -1;
+  EXPECT_THROW(untangle_quads(grid, top, bad), std::invalid_argument);
+  bad = {};
+  bad.max_patch_quads = -1;
   EXPECT_THROW(untangle_quads(grid, top, bad), std::invalid_argument);
 }
 
