@@ -514,6 +514,13 @@ TEST(QuadCli, CleanErrors) {
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --refine-bound-growth 0.9").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --finer-contours 0.5").code, 2);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --map " + quoted(dir + "/none")).code, 3);
+  // The options of building a map, with a map given, are a usage error rather than ignored.
+  for (const std::string option : {"--da 0.1", "--dz 0.05", "--align none", "--smooth-sweeps 5", "--separate never",
+                                   "--equalise-axes never", "--finer-contours 1", "--thin-parts 0", "--split-edges 0"}) {
+    const test::CliRun both = polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --map " + quoted(dir) + " " + option);
+    EXPECT_EQ(both.code, 2) << option;
+    EXPECT_NE(both.err.find("--map excludes " + option.substr(0, option.find(' '))), std::string::npos) << both.err;
+  }
   EXPECT_EQ(polycube_cli("quad " + quoted(test::data_path("bad/open-cube.off")) + " -o " + quoted(dir + "/q.obj")).code, 4);
   EXPECT_EQ(polycube_cli("quad " + mesh + " -o " + quoted(dir + "/missing/q.obj")).code, 5);
   // A map directory of another model is refused, not remeshed into garbage.
