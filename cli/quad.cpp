@@ -840,8 +840,6 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
   target->excludes(size);
   CLI::Option* map_dir =
       command->add_option("--map", options->map_dir, "Directory written by `polycube map` (reuses its map instead of building one)");
-  // The options of building a map mean nothing with --map: given together, a usage error.
-  std::vector<CLI::Option*> building;
   command->add_option("--smooth", options->smooth, "Relaxation sweeps on the model at most, towards right angles and even sizes (stops when converged; never flips a quad; 0: none)")
       ->capture_default_str()
       ->check(CLI::Range(0, 10000));
@@ -880,20 +878,17 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
   command->add_option("--smooth-sweeps", options->smooth_map_sweeps, "Sweeps of the map smoothing before carrying the grid (as `map --smooth-sweeps`; 0: the unsmoothed map; not with --map)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000));
-  building.push_back(command->get_option("--smooth-sweeps"));
   command->add_option("--align", options->align,
                       "Orientation search (not with --map): auto as for `map` (fewest corners, then maps scored by flips); "
                       "corners: fewest polycube corners only (no candidate maps, faster); none: the input's orientation")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "corners", "none"}));
-  building.push_back(command->get_option("--align"));
   command->add_option("--equalise-axes", options->equalise_axes,
                       "As for `map` (not with --map): auto: a model far longer than wide is searched first on a copy with its "
                       "principal axes scaled to within 4 times of each other, the model itself when those quads fall short; "
                       "never: the model itself only")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "never"}));
-  building.push_back(command->get_option("--equalise-axes"));
   command->add_option("--separate", options->separate,
                       "A model that intersects itself (not with --map): never: the model only; auto: when none of its orientations "
                       "gives a polycube, that search and the later ones on that model run on a copy pulled apart round the crossings "
@@ -901,36 +896,33 @@ void add_quad_command(CLI::App& app, const GlobalOptions& global, CommandRunner&
                       "where they are relaxed, fitted, refined and measured like any other try")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "always", "never"}));
-  building.push_back(command->get_option("--separate"));
   command->add_option("--dz", options->topology.dz, "Largest gap between cutting planes, unit-cube units (paper's d_z; not with --map)")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));
-  building.push_back(command->get_option("--dz"));
   command->add_option("--da", options->polycube.da, "Area tolerance of the axis-aligned contours (paper's d_a; not with --map)")
       ->capture_default_str()
       ->check(CLI::Range(1e-3, 1.0));
-  building.push_back(command->get_option("--da"));
   command->add_option("--finer-contours", options->finer_contours,
                       "When the quads of every orientation tried still fall short (flipped, or beyond 0.5 % of the diagonal), "
                       "try again with d_a divided by this (not with --map); 1: never")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
-  building.push_back(command->get_option("--finer-contours"));
   command->add_option("--thin-parts", options->thin_parts,
                       "When the quads still fall short after that: try again keeping thin parts (tails, fins) in the polycube "
                       "wherever they reach farther than this fraction of the largest bounding-box side from its cells (not "
                       "with --map); 0: never")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  building.push_back(command->get_option("--thin-parts"));
   add_time_limit_option(*command, options->time_limit);
   command->add_option("--split-edges", options->split_edges,
                       "Before building the map, split the model's edges longer than this times the quad size (same surface; a "
                       "coarse CAD model's map shears the quads otherwise; not with --map); 0: never")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1000.0));
-  building.push_back(command->get_option("--split-edges"));
-  for (CLI::Option* option : building) option->excludes(map_dir);
+  // The options of building a map mean nothing with --map: given together, a usage error.
+  for (const char* building : {"--smooth-sweeps", "--align", "--equalise-axes", "--separate", "--dz", "--da", "--finer-contours",
+                               "--thin-parts", "--split-edges"})
+    command->get_option(building)->excludes(map_dir);
   command->callback([options, &global, &runner] { runner = [options, &global] { return run_quad(*options, global); }; });
 }
 
