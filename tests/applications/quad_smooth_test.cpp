@@ -339,8 +339,8 @@ TEST(QuadUntangle, LaysOutAMirroredPatchAgain) {
       EXPECT_EQ(r.mesh.V.row(v), grid.V.row(v)) << "the grid's rim stays";
     }
   }
-  // Patches larger than max_patch_quads are not tried: with room for fewer quads than the
-  // mirrored block has, no patch can turn it back.
+  // Patches larger than max_patch_quads are not tried: with a cap below the smallest patch (one
+  // ring, 9 quads), none is laid out and the mirrored block stays flipped.
   QuadUntangleOptions small_patches;
   small_patches.max_patch_quads = 8;
   const QuadUntangleResult capped = untangle_quads(grid, top, small_patches);
