@@ -168,7 +168,7 @@ struct QuadUntangleOptions {
   // rings has 169 quads, a round one of radius 6 about 113; the largest tried by default on
   // anchor, elk, femur and cow had 277, 544, 2 413 and 3 248. Where a layout is all slivers (femur through a map whose P has 2 952
   // corners: 224 528 quads, each a layout cell of its own), round patches reached 41 665 quads
-  // and the patches of 231 flipped quads did not end in 10 minutes.
+  // and the patches of 231 flipped quads had not ended after 14 minutes.
   int max_patch_quads = 5000;
   // Collapsed quads count as bad (false: flipped ones only).
   bool collapsed = true;
