@@ -5,13 +5,19 @@
 #include "polycube/mesh_topology.h"
 #include "polycube/separate.h"
 
+#include <CGAL/AABB_segment_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
 #include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Simple_cartesian.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <iomanip>
+#include <limits>
+#include <map>
 #include <queue>
 #include <set>
 #include <sstream>
@@ -71,6 +77,155 @@ Eigen::MatrixX3i to_matrix(const std::vector<std::array<int, 3>>& triangles) {
   Eigen::MatrixX3i F(triangles.size(), 3);
   for (size_t f = 0; f < triangles.size(); ++f) F.row(f) << triangles[f][0], triangles[f][1], triangles[f][2];
   return F;
+}
+
+// What a seam repair is judged by: boundary edges, and non-manifold edges plus vertices.
+struct SeamDefects {
+  long long boundary = 0;
+  long long nonmanifold = 0;
+};
+
+SeamDefects seam_defects(const std::vector<std::array<int, 3>>& triangles, int num_vertices) {
+  const Eigen::MatrixX3i F = to_matrix(triangles);
+  const EdgeMap map = build_edge_map(F);
+  SeamDefects d;
+  d.boundary = (map.face_count.array() == 1).count();
+  d.nonmanifold = (map.face_count.array() > 2).count();
+  if (d.nonmanifold == 0) d.nonmanifold = count_nonmanifold_vertices(F, num_vertices);
+  return d;
+}
+
+// A repair of seams is kept only when it leaves fewer boundary edges and no more non-manifold
+// edges or vertices (so an open mesh whose boundary touches itself is not pinched shut).
+bool seams_better(const SeamDefects& after, const SeamDefects& before) {
+  return after.boundary < before.boundary && after.nonmanifold <= before.nonmanifold;
+}
+
+// Per boundary edge of the triangles (an edge of one face): that face, and the edge's corner in it
+// (the edge runs from corner i to corner i + 1).
+std::vector<std::pair<int, int>> boundary_edges_of(const std::vector<std::array<int, 3>>& triangles) {
+  const Eigen::MatrixX3i F = to_matrix(triangles);
+  const EdgeMap map = build_edge_map(F);
+  std::vector<std::pair<int, int>> edges;
+  for (int f = 0; f < F.rows(); ++f)
+    for (int i = 0; i < 3; ++i)
+      if (map.face_count[map.FE(f, i)] == 1) edges.emplace_back(f, i);
+  return edges;
+}
+
+// Boundary vertices at exactly the position of another boundary vertex merged into the first of
+// them: a surface written one triangle at a time (a soup), or a seam written twice (a UV or normal
+// split of an exporter). Faces left with a repeated corner are dropped. Kept when seams_better;
+// returns the vertices merged (0 when nothing changed).
+int weld_boundary_vertices(std::vector<std::array<int, 3>>& triangles, const std::vector<Eigen::Vector3d>& points) {
+  const std::vector<std::pair<int, int>> edges = boundary_edges_of(triangles);
+  if (edges.empty()) return 0;
+  std::vector<int> boundary;
+  for (const auto& [f, i] : edges) boundary.push_back(triangles[f][i]);
+  std::sort(boundary.begin(), boundary.end());
+  boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+  const auto key = [&](int v) { return std::array<double, 3>{points[v].x(), points[v].y(), points[v].z()}; };
+  std::map<std::array<double, 3>, int> first;
+  std::vector<int> target(points.size());
+  for (size_t v = 0; v < target.size(); ++v) target[v] = static_cast<int>(v);
+  int merged = 0;
+  for (int v : boundary) {  // ascending: the first of a group keeps its index
+    const auto [it, inserted] = first.emplace(key(v), v);
+    if (!inserted) {
+      target[v] = it->second;
+      ++merged;
+    }
+  }
+  if (merged == 0) return 0;
+  std::vector<std::array<int, 3>> welded;
+  welded.reserve(triangles.size());
+  for (auto t : triangles) {
+    for (int& v : t) v = target[v];
+    if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) welded.push_back(t);
+  }
+  const int n = static_cast<int>(points.size());
+  if (!seams_better(seam_defects(welded, n), seam_defects(triangles, n))) return 0;
+  triangles = std::move(welded);
+  return merged;
+}
+
+// T-junctions: a boundary vertex inside a boundary edge of another face, within `tolerance` (one
+// side of a seam has a vertex that the other side lacks). The face of that edge is split at the
+// vertex (a fan at its opposite corner; the vertex does not move), in rounds while that finds
+// some. Kept when seams_better; returns the faces split (0 when nothing changed).
+int split_t_junctions(std::vector<std::array<int, 3>>& triangles, const std::vector<Eigen::Vector3d>& points,
+                      double tolerance) {
+  using K = CGAL::Simple_cartesian<double>;
+  using Segments = std::vector<K::Segment_3>;
+  using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, CGAL::AABB_segment_primitive<K, Segments::const_iterator>>>;
+  const int n = static_cast<int>(points.size());
+  const SeamDefects before = seam_defects(triangles, n);
+  if (before.boundary == 0) return 0;
+  std::vector<std::array<int, 3>> split = triangles;
+  int faces_split = 0;
+  for (int round = 0; round < 8; ++round) {
+    const std::vector<std::pair<int, int>> edges = boundary_edges_of(split);
+    Segments segments;
+    std::vector<int> boundary;
+    const auto point = [&](int v) { return K::Point_3(points[v].x(), points[v].y(), points[v].z()); };
+    for (const auto& [f, i] : edges) {
+      const int a = split[f][i], b = split[f][(i + 1) % 3];
+      segments.emplace_back(point(a), point(b));
+      boundary.push_back(a);
+    }
+    std::sort(boundary.begin(), boundary.end());
+    boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+    const Tree tree(segments.cbegin(), segments.cend());
+    // Per face, the vertices inside its one split edge this round, by their place along it.
+    std::map<int, std::pair<int, std::vector<std::pair<double, int>>>> cuts;  // face -> (corner, (t, vertex))
+    std::vector<Tree::Primitive_id> hits;
+    for (int v : boundary) {
+      const Eigen::Vector3d& p = points[v];
+      hits.clear();
+      tree.all_intersected_primitives(CGAL::Bbox_3(p.x() - tolerance, p.y() - tolerance, p.z() - tolerance,
+                                                   p.x() + tolerance, p.y() + tolerance, p.z() + tolerance),
+                                      std::back_inserter(hits));
+      for (const auto& hit : hits) {
+        const auto [f, i] = edges[hit - segments.cbegin()];
+        const int a = split[f][i], b = split[f][(i + 1) % 3];
+        if (v == a || v == b || v == split[f][(i + 2) % 3]) continue;
+        const Eigen::Vector3d ab = points[b] - points[a];
+        const double t = (p - points[a]).dot(ab) / ab.squaredNorm();
+        if (!(t > 0 && t < 1) || (points[a] + t * ab - p).norm() > tolerance) continue;
+        if ((p - points[a]).norm() <= tolerance || (p - points[b]).norm() <= tolerance) continue;
+        auto& cut = cuts[f];
+        if (cut.second.empty()) cut.first = i;
+        if (cut.first == i) cut.second.emplace_back(t, v);  // another edge of the face: next round
+      }
+    }
+    if (cuts.empty()) break;
+    std::vector<char> replaced(split.size(), 0);
+    std::vector<std::array<int, 3>> added;
+    for (auto& [f, cut] : cuts) {
+      auto& [i, along] = cut;
+      std::sort(along.begin(), along.end());
+      along.erase(std::unique(along.begin(), along.end(), [](const auto& x, const auto& y) { return x.second == y.second; }),
+                  along.end());
+      const int a = split[f][i], b = split[f][(i + 1) % 3], c = split[f][(i + 2) % 3];
+      int from = a;
+      for (const auto& [t, v] : along) {
+        added.push_back({from, v, c});
+        from = v;
+      }
+      added.push_back({from, b, c});
+      replaced[f] = 1;
+      ++faces_split;
+    }
+    std::vector<std::array<int, 3>> next;
+    next.reserve(split.size() + added.size());
+    for (size_t f = 0; f < split.size(); ++f)
+      if (!replaced[f]) next.push_back(split[f]);
+    next.insert(next.end(), added.begin(), added.end());
+    split = std::move(next);
+  }
+  if (faces_split == 0 || !seams_better(seam_defects(split, n), before)) return 0;
+  triangles = std::move(split);
+  return faces_split;
 }
 
 // Keeps the rows of F marked in keep.
@@ -262,6 +417,25 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   if (collapsed_polygons > 0)
     result.repairs.push_back("removed " + plural(collapsed_polygons, "face") + " with repeated corners");
 
+  // Seams: copies of one point on a boundary merged, then T-junctions split (both only where the
+  // mesh has a boundary, so a closed mesh is never touched).
+  if (const int welded = weld_boundary_vertices(triangles, soup.points); welded > 0)
+    result.repairs.push_back("merged " + plural(welded, "boundary vertex") + " into others at the same position");
+  {
+    BoundingBox box;
+    box.min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    box.max = -box.min;
+    for (const auto& t : triangles)
+      for (int v : t) {
+        box.min = box.min.cwiseMin(soup.points[v]);
+        box.max = box.max.cwiseMax(soup.points[v]);
+      }
+    const double tolerance = kTJunctionTolerance * box.diagonal();
+    if (std::isfinite(tolerance) && tolerance > 0)
+      if (const int split = split_t_junctions(triangles, soup.points, tolerance); split > 0)
+        result.repairs.push_back("split " + plural(split, "face") + " at T-junctions (a boundary vertex inside another face's edge)");
+  }
+
   // Drop exact duplicates (same corner set), keeping the first.
   {
     std::set<std::array<int, 3>> seen;
@@ -333,7 +507,9 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   if (options.fill_holes && repairable) {
     if (const int loops = static_cast<int>(boundary_loops(mesh.F).size()); loops > 0) {
       fill_holes(mesh);
-      result.repairs.push_back("filled " + plural(loops, "hole"));
+      const int left = static_cast<int>(boundary_loops(mesh.F).size());
+      if (left < loops)
+        result.repairs.push_back("filled " + plural(loops - left, "hole") + (left > 0 ? " of " + std::to_string(loops) : ""));
     }
   }
 
@@ -385,7 +561,10 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   if (!d.orientable) d.problems.push_back("not orientable (no consistent face orientation exists)");
   if (d.boundary_edges > 0)
     d.problems.push_back("open surface: " + plural(d.boundary_loops, "boundary loop") + " (" +
-                         plural(d.boundary_edges, "boundary edge") + "; --fill-holes closes them)");
+                         plural(d.boundary_edges, "boundary edge") +
+                         (!options.fill_holes ? "; --fill-holes closes them)"
+                          : repairable        ? "; --fill-holes could not close them)"
+                                              : "; --fill-holes needs a manifold, oriented mesh)"));
   if (d.components > 1)
     d.problems.push_back(plural(d.components, "connected component") + " (--largest-component keeps the largest)");
   if (d.degenerate_faces > 0) d.problems.push_back(plural(d.degenerate_faces, "zero-area face") + " that could not be removed");

@@ -13,6 +13,9 @@ namespace polycube {
 
 // The model's size the stages compute with: squared areas (about diagonal^4) stay normal doubles.
 inline constexpr double kSmallestDiagonal = 1e-50, kLargestDiagonal = 1e50;
+// A boundary vertex within this times the bounding-box diagonal of the inside of another face's
+// boundary edge is a T-junction, and that face is split there (prepare_mesh).
+inline constexpr double kTJunctionTolerance = 1e-5;
 
 struct PrepareOptions {
   // Close every boundary loop with CGAL's hole filling (triangulate and refine, no fairing).
@@ -68,7 +71,9 @@ struct PreparedMesh {
 };
 
 // Triangulates polygons, removes repeated-vertex and duplicate faces and unreferenced vertices,
-// orients faces consistently and outward, applies the optional repairs, removes zero-area faces
+// closes seams where the mesh has a boundary (boundary vertices at exactly one position merged,
+// faces split at T-junctions; each kept only when it leaves fewer boundary edges and no more
+// non-manifold edges or vertices), orients faces consistently and outward, applies the optional repairs, removes zero-area faces
 // where that keeps the mesh valid, and diagnoses the result. Never throws for mesh problems
 // (they go to diagnosis.problems); throws InputError for non-finite coordinates or bad indices.
 PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options = {});

@@ -294,6 +294,65 @@ TEST(Validate, AModelFarFromTheOriginIsMovedThere) {
   EXPECT_TRUE(prepare_mesh(soup, never).offset.isZero(0));
 }
 
+// Every triangle with its own copies of its corners (a soup, as some exporters write PLY and OFF):
+// the boundary vertices at one position are merged, and the mesh is the one the soup was made of.
+TEST(Validate, ASoupOfSeparateTrianglesIsWelded) {
+  const TriMesh sphere = test::load_mesh_file(test::data_path("sphere.off"));
+  PolygonSoup soup;
+  for (int f = 0; f < sphere.num_faces(); ++f) {
+    std::vector<int> polygon;
+    for (int k = 0; k < 3; ++k) {
+      polygon.push_back(static_cast<int>(soup.points.size()));
+      soup.points.push_back(sphere.V.row(sphere.F(f, k)).transpose());
+    }
+    soup.polygons.push_back(polygon);
+  }
+  const PreparedMesh prepared = prepare_mesh(soup);
+  EXPECT_TRUE(prepared.diagnosis.valid()) << (prepared.diagnosis.problems.empty() ? "" : prepared.diagnosis.problems[0]);
+  EXPECT_EQ(prepared.diagnosis.vertices, sphere.num_vertices());
+  EXPECT_EQ(prepared.diagnosis.faces, sphere.num_faces());
+  EXPECT_EQ(prepared.diagnosis.genus, 0);
+  EXPECT_NEAR(surface_area(prepared.mesh), surface_area(sphere), 1e-12);
+  ASSERT_FALSE(prepared.repairs.empty());
+  EXPECT_NE(prepared.repairs.front().find("merged " + std::to_string(3 * sphere.num_faces() - sphere.num_vertices()) +
+                                          " boundary vertices"),
+            std::string::npos)
+      << prepared.repairs.front();
+
+  // A closed mesh is never welded: two tetrahedra touching at one point stay two components.
+  PolygonSoup touching = merge(tetrahedron(0), tetrahedron(1));  // (1, 0, 0) twice
+  const PreparedMesh apart = prepare_mesh(touching);
+  EXPECT_EQ(apart.diagnosis.components, 2);
+  EXPECT_EQ(apart.diagnosis.nonmanifold_vertices, 0);
+}
+
+// A cube whose top is two rectangles: their shared side ends at the middles of two top edges,
+// which the front and back faces do not have (T-junctions, as polyhedra written with a vertex
+// inside an edge are). Those faces are split there, and the cube is closed; a vertex off the edge
+// by more than the tolerance is not a T-junction, and the surface stays open.
+TEST(Validate, TJunctionsAreSplit) {
+  const auto split_top = [](double off) {
+    PolygonSoup soup = cube_quads();
+    soup.points.push_back({0.5, -off, 1});  // 8: inside edge 4-5
+    soup.points.push_back({0.5, 1, 1});     // 9: inside edge 6-7
+    soup.polygons[1] = {4, 8, 9, 7};
+    soup.polygons.push_back({8, 5, 6, 9});
+    return prepare_mesh(soup);
+  };
+  const PreparedMesh split = split_top(1e-7);  // within kTJunctionTolerance × √3
+  EXPECT_TRUE(split.diagnosis.valid()) << (split.diagnosis.problems.empty() ? "" : split.diagnosis.problems[0]);
+  EXPECT_EQ(split.diagnosis.genus, 0);
+  EXPECT_NEAR(signed_volume(split.mesh), 1.0, 1e-6);
+  EXPECT_NE(std::find(split.repairs.begin(), split.repairs.end(),
+                      "split 2 faces at T-junctions (a boundary vertex inside another face's edge)"),
+            split.repairs.end());
+
+  const PreparedMesh open = split_top(1e-3);
+  EXPECT_FALSE(open.diagnosis.valid());
+  EXPECT_EQ(open.diagnosis.boundary_loops, 1);  // 6-7 is split at 9; 4-5 and 4-8-5 stay open
+  EXPECT_EQ(open.diagnosis.boundary_edges, 3);
+}
+
 TEST(Validate, EmptySoupIsNotMappable) {
   const PreparedMesh prepared = prepare_mesh(PolygonSoup{});
   EXPECT_FALSE(prepared.diagnosis.valid());
