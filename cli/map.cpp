@@ -210,6 +210,11 @@ struct Attempt : AlignedStages {
   bool scaled() const { return unscaled_source != nullptr; }
   std::unique_ptr<MapRefinementResult> refinement;  // P's sampling refined before the smoothing
   std::unique_ptr<Finished> finished;               // after it: the P and sampling written
+  // A separated model's map as it will be written: P's images moved from the copy to the model
+  // (turned by rotation), audited and untangled there. Null without separation.
+  std::unique_ptr<Finished> on_model;
+  // What the attempt is judged by (rank, contract): the map as it will be written.
+  const Finished& judged() const { return on_model ? *on_model : *finished; }
   nlohmann::json refinement_report = nullptr;
   double refine_seconds = 0, smooth_unrefined_seconds = 0, seconds = 0;
   std::string name;  // orientation (and finer contours)
@@ -571,8 +576,29 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   double align_seconds = 0;
   std::string first_choice;  // the first search's orientation
   const auto shortfall = [&]() {
-    return "the finished map has " + std::to_string(kept->finished->bad_p()) + " / " + std::to_string(kept->finished->bad_m()) +
-           " flipped, image area " + std::to_string(kept->finished->audit.polycube_to_model.area_ratio) + "; ";
+    const Finished& f = kept->judged();
+    return "the finished map has " + std::to_string(f.bad_p()) + " / " + std::to_string(f.bad_m()) + " flipped, image area " +
+           std::to_string(f.audit.polycube_to_model.area_ratio) + (kept->on_model ? " on the model" : "") + "; ";
+  };
+  // A separated model's finished map (of attempt a) taken to the model and audited there, where
+  // the files are written: the copy's audit can meet the contract where the model's does not
+  // (images moved back turn against the model where its sheets pass near each other, or the
+  // area shrinks), and the attempts compete by what will be written. Null without separation.
+  const auto on_model_of = [&](const Attempt& a, const Finished& f) -> std::unique_ptr<Finished> {
+    if (!separation) return nullptr;
+    const TriMesh model = rotated(prepared.mesh, a.rotation);
+    auto m = std::make_unique<Finished>();
+    m->polycube = f.polycube;
+    m->on_model_xyz = to_original_surface(a.model, model, f.on_model_xyz);
+    m->on_polycube_xyz = f.on_polycube_xyz;
+    m->audit = audit_map(model, f.polycube->mesh, m->on_model_xyz, m->on_polycube_xyz);
+    if (m->bad_p() > f.bad_p() || m->bad_m() > f.bad_m()) {
+      progress.stage("audit", "on the model itself: " + std::to_string(m->bad_p()) + " / " + std::to_string(m->bad_m()) +
+                                  " flipped or degenerate image triangles, against " + std::to_string(f.bad_p()) + " / " +
+                                  std::to_string(f.bad_m()) + " on the separated copy");
+      untangle_images(model, *m, options.untangle_shift, options.untangle_shift_max, progress);
+    }
+    return m;
   };
   // A pass on a long model's scaled copy (equalised) runs its stages on the copy.
   auto run_pass = [&](const MapOptions& pass, nlohmann::json& alignment_report, const std::string& suffix,
@@ -633,12 +659,13 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       if (kept && time_limit.spent(progress)) return;
       if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
       run_stages(a, stages_source, pass, progress);
+      if (a.finished) a.on_model = on_model_of(a, *a.finished);
       if (!a.finished) {
         kept = &a;
         return;
       }
-      if (!kept || a.finished->rank() < kept->finished->rank()) kept = &a;
-      if (kept->finished->meets_contract()) return;
+      if (!kept || a.judged().rank() < kept->judged().rank()) kept = &a;
+      if (kept->judged().meets_contract()) return;
     }
   };
   // A model much longer than wide: first on its scaled copy (equalised_copy); the model itself
@@ -655,9 +682,9 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       report["alignment"]["equalised"]["error"] = e.what();
     }
   }
-  if (!kept || (kept->finished && (!kept->finished->meets_contract() || kept->finished->audit.distortion.eps_angle > kEqualiseKeepAngle))) {
+  if (!kept || (kept->finished && (!kept->judged().meets_contract() || kept->judged().audit.distortion.eps_angle > kEqualiseKeepAngle))) {
     if (kept) {
-      const Finished& copy = *kept->finished;
+      const Finished& copy = kept->judged();
       progress.stage("equalise", (copy.meets_contract() ? "the copy's map has eps_angle " + std::to_string(copy.audit.distortion.eps_angle) + "; "
                                                          : shortfall()) +
                                      "now the model itself");
@@ -678,7 +705,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   // 7 % of the diagonal from P's image, 0.972 of the area at d_a 0.3; at 0.1 the orientations
   // rank differently and the new first one gives 0.981). A finer P can also flip more: the
   // maps compete by rank.
-  if (kept && kept->finished && !kept->finished->meets_contract() && options.finer_contours > 1 && !time_limit.spent(progress)) {
+  if (kept && kept->finished && !kept->judged().meets_contract() && options.finer_contours > 1 && !time_limit.spent(progress)) {
     MapOptions finer = options;
     finer.polycube.da = options.polycube.da / options.finer_contours;
     std::ostringstream suffix;
@@ -694,11 +721,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   // finished map's unsmoothed φ (exact_map), best-ranked first, until one meets the contract. Not
   // earlier: where a smoothed map meets the contract it has the lower distortion (joint:
   // ε_angle 1.03 smoothed, after its second orientation, against 2.10 exact on its first).
-  if (options.exact && kept && kept->finished && !kept->finished->meets_contract()) {
+  if (options.exact && kept && kept->finished && !kept->judged().meets_contract()) {
     std::vector<Attempt*> order;
     for (const auto& a : attempts)
       if (a->finished && a->map && !a->scaled()) order.push_back(a.get());  // (a scaled copy's map data is the copy's)
-    std::stable_sort(order.begin(), order.end(), [](const Attempt* x, const Attempt* y) { return x->finished->rank() < y->finished->rank(); });
+    std::stable_sort(order.begin(), order.end(), [](const Attempt* x, const Attempt* y) { return x->judged().rank() < y->judged().rank(); });
     for (Attempt* a : order) {
       if (time_limit.spent(progress)) break;
       progress.stage("retry", shortfall() + "the exact sampling of " + a->name);
@@ -713,7 +740,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
         a->seconds += progress.elapsed_seconds() - start;
         continue;
       }
-      const bool better = exact->rank() < a->finished->rank();
+      std::unique_ptr<Finished> exact_on_model = on_model_of(*a, *exact);
+      const bool better = (exact_on_model ? *exact_on_model : *exact).rank() < a->judged().rank();
       progress.stage("exact", std::string(better ? "kept" : "not kept") + " (" + std::to_string(exact->bad_p()) + " / " +
                                   std::to_string(exact->bad_m()) + " against " + std::to_string(a->finished->bad_p()) + " / " +
                                   std::to_string(a->finished->bad_m()) + ")");
@@ -722,23 +750,29 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       tried["polycube_to_model"] = direction_json(exact->audit.polycube_to_model);
       tried["model_to_polycube"] = direction_json(exact->audit.model_to_polycube);
       tried["seconds_total"] = progress.elapsed_seconds() - start;  // the sampling and its untangling
-      if (better) a->finished = std::move(exact);
+      if (better) {
+        a->finished = std::move(exact);
+        a->on_model = std::move(exact_on_model);
+      }
       a->finished->overlay = tried;
       a->seconds += progress.elapsed_seconds() - start;
-      if (a->finished->rank() < kept->finished->rank()) kept = a;
-      if (kept->finished->meets_contract()) break;
+      if (a->judged().rank() < kept->judged().rank()) kept = a;
+      if (kept->judged().meets_contract()) break;
     }
   }
   time_limit.warn(progress, "other orientations, finer contours and exact samplings");
   if (time_limit.seconds > 0) report["time_limit"] = {{"seconds", time_limit.seconds}, {"reached", time_limit.reached}};
   if (separation && kept->finished) {
-    // P's images on the copy, moved to the same faces and barycentric coordinates of the model;
-    // the audit on the copy goes to the report, the files' audit on the model is made below.
+    // P's images on the copy, moved to the same faces and barycentric coordinates of the model
+    // (on_model_of: untangled there where they flip only there); the audit on the copy goes to
+    // the report, the files' audit on the model is made below.
     Finished& finished = *kept->finished;
     report["separation"]["on_copy"] = {{"polycube_to_model", direction_json(finished.audit.polycube_to_model)},
                                        {"model_to_polycube", direction_json(finished.audit.model_to_polycube)},
                                        {"eps_angle", finished.audit.distortion.eps_angle}};
-    finished.on_model_xyz = to_original_surface(kept->model, rotated(prepared.mesh, kept->rotation), finished.on_model_xyz);
+    finished.on_model_xyz = kept->on_model->on_model_xyz;
+    finished.on_polycube_xyz = kept->on_model->on_polycube_xyz;
+    if (!kept->on_model->untangling.is_null()) report["separation"]["untangling_on_model"] = kept->on_model->untangling;
   }
   const Attempt& chosen = *kept;
   const Eigen::Matrix3d rotation = chosen.rotation;
@@ -752,13 +786,14 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     nlohmann::json finished = nlohmann::json::array();
     for (const std::unique_ptr<Attempt>& a : attempts) {
       if (!a->finished) continue;
+      const Finished& f = a->judged();  // on the model itself when separated
       finished.push_back({{"name", a->name},
-                          {"polycube_to_model_flipped", a->finished->bad_p()},
-                          {"model_to_polycube_flipped", a->finished->bad_m()},
-                          {"area_ratio", a->finished->audit.polycube_to_model.area_ratio},
-                          {"eps_angle", a->finished->audit.distortion.eps_angle},
-                          {"eps_area", a->finished->audit.distortion.eps_area},
-                          {"meets_contract", a->finished->meets_contract()},
+                          {"polycube_to_model_flipped", f.bad_p()},
+                          {"model_to_polycube_flipped", f.bad_m()},
+                          {"area_ratio", f.audit.polycube_to_model.area_ratio},
+                          {"eps_angle", f.audit.distortion.eps_angle},
+                          {"eps_area", f.audit.distortion.eps_area},
+                          {"meets_contract", f.meets_contract()},
                           {"kept", a.get() == kept},
                           {"seconds", a->seconds}});
     }
