@@ -875,22 +875,22 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     on_polycube_xyz = finished.on_polycube_xyz;
     // The files as written, in the input frame and on the model, audited there: the rotation's
     // rounding can decide a near tie on an edge of P the other way (elk: a model triangle 0
-    // flipped in the turned frame, 1 in the input's), and images moved back from a separated
-    // copy can turn against the model where its sheets pass near each other (man: 122 of P's
-    // triangles). The report gives the files' figures; what flips only there is untangled there.
+    // flipped in the turned frame, 1 in the input's). (A separated model's images were moved
+    // back, audited and untangled on the model already: on_model_of.) The report gives the files'
+    // figures; what flips only there is untangled there.
     Polycube P_input = P;
     P_input.mesh = mesh_to_input(P.mesh);
     Finished written;
     written.polycube = &P_input;
     written.on_model_xyz = to_input(finished.on_model_xyz);
     written.on_polycube_xyz = to_input(finished.on_polycube_xyz);
-    written.audit = rotation.isIdentity(0) && !separation
-                        ? finished.audit
-                        : audit_map(prepared.mesh, P_input.mesh, written.on_model_xyz, written.on_polycube_xyz);
-    if (written.bad_p() > finished.bad_p() || written.bad_m() > finished.bad_m()) {
+    const Finished& judged = chosen.judged();  // on the model in the turned frame
+    written.audit = rotation.isIdentity(0) ? judged.audit
+                                           : audit_map(prepared.mesh, P_input.mesh, written.on_model_xyz, written.on_polycube_xyz);
+    if (written.bad_p() > judged.bad_p() || written.bad_m() > judged.bad_m()) {
       progress.stage("audit", "the files as written: " + std::to_string(written.bad_p()) + " / " + std::to_string(written.bad_m()) +
-                                  " flipped or degenerate image triangles, against " + std::to_string(finished.bad_p()) + " / " +
-                                  std::to_string(finished.bad_m()) + (separation ? " on the separated copy" : " in the turned frame"));
+                                  " flipped or degenerate image triangles, against " + std::to_string(judged.bad_p()) + " / " +
+                                  std::to_string(judged.bad_m()) + " in the turned frame");
       untangle_images(prepared.mesh, written, options.untangle_shift, options.untangle_shift_max, progress);
       report["written"] = {{"untangling", written.untangling}};
     }
