@@ -741,10 +741,14 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
         continue;
       }
       std::unique_ptr<Finished> exact_on_model = on_model_of(*a, *exact);
-      const bool better = (exact_on_model ? *exact_on_model : *exact).rank() < a->judged().rank();
-      progress.stage("exact", std::string(better ? "kept" : "not kept") + " (" + std::to_string(exact->bad_p()) + " / " +
-                                  std::to_string(exact->bad_m()) + " against " + std::to_string(a->finished->bad_p()) + " / " +
-                                  std::to_string(a->finished->bad_m()) + ")");
+      const Finished &judged_exact = exact_on_model ? *exact_on_model : *exact, &judged_before = a->judged();
+      const bool better = judged_exact.rank() < judged_before.rank();
+      progress.stage("exact", std::string(better ? "kept" : "not kept") + " (" + std::to_string(judged_exact.bad_p()) + " / " +
+                                  std::to_string(judged_exact.bad_m()) + " flipped, image area " +
+                                  std::to_string(judged_exact.audit.polycube_to_model.area_ratio) + " against " +
+                                  std::to_string(judged_before.bad_p()) + " / " + std::to_string(judged_before.bad_m()) + ", " +
+                                  std::to_string(judged_before.audit.polycube_to_model.area_ratio) +
+                                  (exact_on_model ? ", on the model)" : ")"));
       nlohmann::json tried = exact->overlay;
       tried["kept"] = better;
       tried["polycube_to_model"] = direction_json(exact->audit.polycube_to_model);
