@@ -180,6 +180,18 @@ TEST(Validate, NonManifoldEdgeAndVertex) {
   EXPECT_EQ(prepared.diagnosis.nonmanifold_edges, 1);
   EXPECT_FALSE(prepared.diagnosis.genus.has_value());
   EXPECT_FALSE(prepared.diagnosis.valid());
+  // Open too: --fill-holes cannot fill a non-manifold mesh, and the problem says so instead of
+  // suggesting it.
+  PrepareOptions fill;
+  fill.fill_holes = true;
+  const PreparedMesh unfilled = prepare_mesh(fin, fill);
+  EXPECT_GT(unfilled.diagnosis.boundary_edges, 0);
+  const auto says = [](const MeshDiagnosis& d, const std::string& text) {
+    return std::any_of(d.problems.begin(), d.problems.end(), [&](const std::string& p) { return p.find(text) != std::string::npos; });
+  };
+  EXPECT_TRUE(says(unfilled.diagnosis, "--fill-holes needs a manifold, oriented mesh"));
+  EXPECT_FALSE(says(unfilled.diagnosis, "--fill-holes closes them"));
+  EXPECT_TRUE(says(prepared.diagnosis, "--fill-holes closes them"));
 
   // Two tetrahedra sharing one vertex (the apex of the second is vertex 0 of the first).
   PolygonSoup bowtie = tetrahedron();
