@@ -79,14 +79,23 @@ Eigen::MatrixX3i to_matrix(const std::vector<std::array<int, 3>>& triangles) {
   return F;
 }
 
-// What a seam repair is judged by: boundary edges, and non-manifold edges plus vertices.
+// What a seam repair is judged by: boundary edges, and non-manifold edges (where there are none,
+// non-manifold vertices, which are only counted on edge-manifold faces). Faces with the same
+// corners count once (the duplicates a welded soup may hold are removed after the repairs).
 struct SeamDefects {
   long long boundary = 0;
   long long nonmanifold = 0;
 };
 
 SeamDefects seam_defects(const std::vector<std::array<int, 3>>& triangles, int num_vertices) {
-  const Eigen::MatrixX3i F = to_matrix(triangles);
+  std::set<std::array<int, 3>> seen;
+  std::vector<std::array<int, 3>> unique;
+  for (const auto& t : triangles) {
+    std::array<int, 3> key = t;
+    std::sort(key.begin(), key.end());
+    if (seen.insert(key).second) unique.push_back(t);
+  }
+  const Eigen::MatrixX3i F = to_matrix(unique);
   const EdgeMap map = build_edge_map(F);
   SeamDefects d;
   d.boundary = (map.face_count.array() == 1).count();

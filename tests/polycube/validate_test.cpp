@@ -319,6 +319,10 @@ TEST(Validate, ASoupOfSeparateTrianglesIsWelded) {
     }
     soup.polygons.push_back(polygon);
   }
+  // One face written twice, with its own corners again: a duplicate once welded, removed after.
+  soup.points.insert(soup.points.end(), soup.points.begin(), soup.points.begin() + 3);
+  soup.polygons.push_back({static_cast<int>(soup.points.size()) - 3, static_cast<int>(soup.points.size()) - 2,
+                           static_cast<int>(soup.points.size()) - 1});
   const PreparedMesh prepared = prepare_mesh(soup);
   EXPECT_TRUE(prepared.diagnosis.valid()) << (prepared.diagnosis.problems.empty() ? "" : prepared.diagnosis.problems[0]);
   EXPECT_EQ(prepared.diagnosis.vertices, sphere.num_vertices());
@@ -326,10 +330,11 @@ TEST(Validate, ASoupOfSeparateTrianglesIsWelded) {
   EXPECT_EQ(prepared.diagnosis.genus, 0);
   EXPECT_NEAR(surface_area(prepared.mesh), surface_area(sphere), 1e-12);
   ASSERT_FALSE(prepared.repairs.empty());
-  EXPECT_NE(prepared.repairs.front().find("merged " + std::to_string(3 * sphere.num_faces() - sphere.num_vertices()) +
+  EXPECT_NE(prepared.repairs.front().find("merged " + std::to_string(3 * sphere.num_faces() + 3 - sphere.num_vertices()) +
                                           " boundary vertices"),
             std::string::npos)
       << prepared.repairs.front();
+  EXPECT_NE(std::find(prepared.repairs.begin(), prepared.repairs.end(), "removed 1 duplicate face"), prepared.repairs.end());
 
   // A closed mesh is never welded: two tetrahedra touching at one point stay two components.
   PolygonSoup touching = merge(tetrahedron(0), tetrahedron(1));  // (1, 0, 0) twice
