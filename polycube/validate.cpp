@@ -79,6 +79,18 @@ Eigen::MatrixX3i to_matrix(const std::vector<std::array<int, 3>>& triangles) {
   return F;
 }
 
+// The triangles without exact duplicates (the same corner set), the first of each kept.
+std::vector<std::array<int, 3>> unique_faces(const std::vector<std::array<int, 3>>& triangles) {
+  std::set<std::array<int, 3>> seen;
+  std::vector<std::array<int, 3>> unique;
+  for (const auto& t : triangles) {
+    std::array<int, 3> key = t;
+    std::sort(key.begin(), key.end());
+    if (seen.insert(key).second) unique.push_back(t);
+  }
+  return unique;
+}
+
 // What a seam repair is judged by: boundary edges, and non-manifold edges (where there are none,
 // non-manifold vertices, which are only counted on edge-manifold faces). Faces with the same
 // corners count once (the duplicates a welded soup may hold are removed after the repairs).
@@ -88,14 +100,7 @@ struct SeamDefects {
 };
 
 SeamDefects seam_defects(const std::vector<std::array<int, 3>>& triangles, int num_vertices) {
-  std::set<std::array<int, 3>> seen;
-  std::vector<std::array<int, 3>> unique;
-  for (const auto& t : triangles) {
-    std::array<int, 3> key = t;
-    std::sort(key.begin(), key.end());
-    if (seen.insert(key).second) unique.push_back(t);
-  }
-  const Eigen::MatrixX3i F = to_matrix(unique);
+  const Eigen::MatrixX3i F = to_matrix(unique_faces(triangles));
   const EdgeMap map = build_edge_map(F);
   SeamDefects d;
   d.boundary = (map.face_count.array() == 1).count();
@@ -447,13 +452,7 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
 
   // Drop exact duplicates (same corner set), keeping the first.
   {
-    std::set<std::array<int, 3>> seen;
-    std::vector<std::array<int, 3>> unique;
-    for (const auto& t : triangles) {
-      std::array<int, 3> key = t;
-      std::sort(key.begin(), key.end());
-      if (seen.insert(key).second) unique.push_back(t);
-    }
+    std::vector<std::array<int, 3>> unique = unique_faces(triangles);
     const int duplicates = static_cast<int>(triangles.size() - unique.size());
     if (duplicates > 0) result.repairs.push_back("removed " + plural(duplicates, "duplicate face"));
     triangles = std::move(unique);
