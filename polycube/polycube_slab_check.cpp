@@ -85,115 +85,185 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
     side_section[s] = present ? &sections.planes[sides[s]->plane] : &empty_section();
     side_leaves[s] = present ? sides[s]->leaves : &empty_leaves();
   }
-  const QuadRaster raster = rasterize({side_leaves[0], side_leaves[1]});
-  const int nx = raster.nx(), ny = raster.ny();
-  const size_t row = static_cast<size_t>(nx) + 2;
-  std::vector<int> faces[2];
-  std::vector<char> solids[2];
-  for (int s = 0; s < 2; ++s) {
-    faces[s] = padded_faces(raster, s, *side_leaves[s]);
-    solids[s].resize(faces[s].size());
-    for (size_t k = 0; k < faces[s].size(); ++k) solids[s][k] = side_section[s]->face_solid[faces[s][k]];
+  // The check is defined on the common grid of the two quadtrees (quadtree_raster.h) and runs
+  // on their common refinement: the finer of the two leaves everywhere, each tile inside one
+  // leaf (or none) of either side. Grid vertices that are no tile corner lie inside a tile or
+  // inside a side two tiles share, and repeat what holds along that side.
+  charge_raster_cells({side_leaves[0], side_leaves[1]});
+  std::vector<int> xs, ys;
+  grid_lines({side_leaves[0], side_leaves[1]}, xs, ys);
+  const LeafLocator side_tiles[2] = {LeafLocator(*side_leaves[0]), LeafLocator(*side_leaves[1])};
+  std::vector<QuadLeaf> common;
+  std::vector<std::array<int, 2>> common_leaf;  // per tile: the leaf of each side, -1 for none
+  for (std::vector<QuadCell> stack = {QuadCell{}}; !stack.empty();) {
+    const QuadCell c = stack.back();
+    stack.pop_back();
+    const int found[2] = {side_tiles[0].find(c), side_tiles[1].find(c)};
+    if (found[0] == LeafLocator::kSubdivided || found[1] == LeafLocator::kSubdivided) {
+      for (int q = 0; q < 4; ++q) stack.push_back({c.level + 1, 2 * c.ix + (q & 1), 2 * c.iy + (q >> 1)});
+      continue;
+    }
+    QuadLeaf tile;
+    tile.cell = c;
+    common.push_back(tile);
+    std::array<int, 2> leaf;
+    for (int s = 0; s < 2; ++s) {
+      const int t = found[s] >= 0 ? found[s] : side_tiles[s].at(c.x0(), c.y0());
+      leaf[s] = t < side_tiles[s].leaves() ? t : -1;
+    }
+    common_leaf.push_back(leaf);
   }
-  auto face = [&](int s, int cx, int cy) { return faces[s][(cy + 1) * row + cx + 1]; };
-  auto solid = [&](int s, int cx, int cy) { return solids[s][(cy + 1) * row + cx + 1] != 0; };
+  const LeafLocator tiles(common);
+  const int nt = tiles.size();
+  const std::vector<TileCorner> corners = tile_corners(tiles);
+  auto leaf = [&](int s, int t) { return t < 0 ? -1 : common_leaf[t][s]; };
+  auto face = [&](int s, int t) {
+    const int l = leaf(s, t);
+    return l < 0 ? 0 : (*side_leaves[s])[l].face;
+  };
+  auto solid = [&](int s, int t) { return side_section[s]->face_solid[face(s, t)] != 0; };
   std::vector<char> refine[2];
   refine[0].assign(side_leaves[0]->size(), 0);
   refine[1].assign(side_leaves[1]->size(), 0);
-  auto mark = [&](int s, int cx, int cy) {
-    const int l = raster.leaf_at(s, cx, cy);
+  auto mark = [&](int s, int l) {
     if (l >= 0 && (*side_leaves[s])[l].mixed) refine[s][l] = 1;
   };
   auto note = [&](const std::string& text) {
     if (result.problem.empty()) result.problem = text;
   };
-  auto vid = [&](int vx, int vy) { return vy * (nx + 1) + vx; };
+  auto on_grid = [](const std::vector<int>& lines, int v) { return std::binary_search(lines.begin(), lines.end(), v); };
+  // Per corner, the sides starting there to the right (tiles below, above) and upwards (left,
+  // right), their far end, and the grid lines strictly inside them.
+  struct Side {
+    int from = 0, to = 0;  // tiles, from below (left)
+    int end = 0;           // x (y) of the far end
+  };
+  auto side_from = [&](const TileCorner& corner, bool upwards) {
+    Side side;
+    side.from = upwards ? corner.around[3] : corner.around[1];
+    side.to = corner.around[2];
+    side.end = kQuadGridSize;
+    for (int t : {side.from, side.to})
+      if (t >= 0) side.end = std::min(side.end, upwards ? tiles.cell(t).y1() : tiles.cell(t).x1());
+    return side;
+  };
+  auto lines_inside = [](const std::vector<int>& lines, int from, int to) {
+    return std::make_pair(std::upper_bound(lines.begin(), lines.end(), from), std::lower_bound(lines.begin(), lines.end(), to));
+  };
 
   // Manifold at every grid vertex of height m.
-  for (int vy = 0; vy <= ny; ++vy)
-    for (int vx = 0; vx <= nx; ++vx) {
-      int occupancy = 0;
-      for (int dz = 0; dz < 2; ++dz)
-        for (int dy = 0; dy < 2; ++dy)
-          for (int dx = 0; dx < 2; ++dx)
-            if (solid(dz, vx - 1 + dx, vy - 1 + dy)) occupancy |= 1 << (dx + 2 * dy + 4 * dz);
-      if (octants_manifold(occupancy)) continue;
-      ++result.nonmanifold_vertices;
-      std::array<int, 8> around;
-      for (int s = 0; s < 2; ++s)
-        for (int dy = 0; dy < 2; ++dy)
-          for (int dx = 0; dx < 2; ++dx) around[4 * s + 2 * dy + dx] = raster.leaf_at(s, vx - 1 + dx, vy - 1 + dy);
-      result.nonmanifold.push_back(around);
-      for (int s = 0; s < 2; ++s)
-        for (int dy = 0; dy < 2; ++dy)
-          for (int dx = 0; dx < 2; ++dx) mark(s, vx - 1 + dx, vy - 1 + dy);
+  struct Bad {
+    int y, x;
+    std::array<int, 8> around;
+  };
+  std::vector<Bad> bad;
+  auto check_vertex = [&](int x, int y, const std::array<int, 4>& quadrant) {  // tiles SW, SE, NW, NE
+    int occupancy = 0;
+    for (int s = 0; s < 2; ++s)
+      for (int q = 0; q < 4; ++q)
+        if (solid(s, quadrant[q])) occupancy |= 1 << (q + 4 * s);
+    if (octants_manifold(occupancy)) return;
+    std::array<int, 8> around;
+    for (int s = 0; s < 2; ++s)
+      for (int q = 0; q < 4; ++q) around[4 * s + q] = leaf(s, quadrant[q]);
+    bad.push_back({y, x, around});
+  };
+  for (const TileCorner& corner : corners) {
+    const auto& a = corner.around;
+    if (on_grid(xs, corner.x) && on_grid(ys, corner.y)) check_vertex(corner.x, corner.y, {a[0], a[1], a[3], a[2]});
+    const Side right = side_from(corner, false), up = side_from(corner, true);
+    if (right.from != right.to) {
+      const auto [first, last] = lines_inside(xs, corner.x, right.end);
+      for (auto x = first; x < last; ++x) check_vertex(*x, corner.y, {right.from, right.from, right.to, right.to});
     }
+    if (up.from != up.to) {
+      const auto [first, last] = lines_inside(ys, corner.y, up.end);
+      for (auto y = first; y < last; ++y) check_vertex(corner.x, *y, {up.from, up.to, up.from, up.to});
+    }
+  }
+  std::stable_sort(bad.begin(), bad.end(), [](const Bad& a, const Bad& b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+  for (const Bad& b : bad) {
+    result.nonmanifold.push_back(b.around);
+    for (int s = 0; s < 2; ++s)
+      for (int q = 0; q < 4; ++q) mark(s, b.around[4 * s + q]);
+  }
+  result.nonmanifold_vertices = static_cast<int>(bad.size());
   if (result.nonmanifold_vertices > 0)
     note(std::to_string(result.nonmanifold_vertices) + " non-manifold vertices between the extrusions");
 
-  // The complex X: closed cells of Q_lo Δ Q_hi and the boundary edges of both, joined at vertices.
-  DisjointSets x_sets((nx + 1) * (ny + 1));
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx)
-      if (solid(0, cx, cy) != solid(1, cx, cy)) {
-        x_sets.unite(vid(cx, cy), vid(cx + 1, cy));
-        x_sets.unite(vid(cx, cy), vid(cx, cy + 1));
-        x_sets.unite(vid(cx, cy), vid(cx + 1, cy + 1));
-      }
-  std::map<int, int> contour_root;  // contour id -> root vertex of its component
-  bool loops_consistent = true;
-  // Boundary edge between cells a and b (a below/left of b) running from vertex v to w.
-  auto boundary_edge = [&](int ax, int ay, int bx, int by, int v, int w) {
-    for (int s = 0; s < 2; ++s) {
-      if (solid(s, ax, ay) == solid(s, bx, by)) continue;
-      x_sets.unite(v, w);
-      const int local = side_section[s]->contour_between(face(s, ax, ay), face(s, bx, by));
-      if (local < 0) {
-        loops_consistent = false;
-        continue;
-      }
-      contour_root.emplace(side_section[s]->contours[local], v);
-    }
+  // The complex X: closed tiles of Q_lo Δ Q_hi and the boundary sides of both, joined at the
+  // tile corners (elements 0 .. corners - 1; the tiles follow).
+  const int nc = static_cast<int>(corners.size());
+  auto corner_at = [&](int x, int y) {
+    const auto it = std::lower_bound(corners.begin(), corners.end(), std::make_pair(y, x),
+                                     [](const TileCorner& c, const std::pair<int, int>& p) {
+                                       return std::make_pair(c.y, c.x) < p;
+                                     });
+    return static_cast<int>(it - corners.begin());
   };
-  for (int cy = 0; cy <= ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx) boundary_edge(cx, cy - 1, cx, cy, vid(cx, cy), vid(cx + 1, cy));
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx <= nx; ++cx) boundary_edge(cx - 1, cy, cx, cy, vid(cx, cy), vid(cx, cy + 1));
+  DisjointSets x_sets(nc + nt);
+  for (int c = 0; c < nc; ++c)
+    for (int t : corners[c].around)
+      if (t >= 0 && solid(0, t) != solid(1, t)) x_sets.unite(c, nc + t);
+  std::map<int, int> contour_root;  // contour id -> a corner of its loop
+  bool loops_consistent = true;
+  for (int c = 0; c < nc; ++c)
+    for (bool upwards : {false, true}) {
+      const Side side = side_from(corners[c], upwards);
+      if (side.from == side.to) continue;
+      const int far = upwards ? corner_at(corners[c].x, side.end) : corner_at(side.end, corners[c].y);
+      for (int s = 0; s < 2; ++s) {
+        if (solid(s, side.from) == solid(s, side.to)) continue;
+        x_sets.unite(c, far);
+        const int local = side_section[s]->contour_between(face(s, side.from), face(s, side.to));
+        if (local < 0) {
+          loops_consistent = false;
+          continue;
+        }
+        contour_root.emplace(side_section[s]->contours[local], c);
+      }
+    }
   if (!loops_consistent) note("a boundary edge of Q separates faces no contour separates");
 
-  // Bounded components of the complement of X (cells in both or in neither), each counted for
-  // the component of X that contains the top edge of its topmost cell.
-  const int infinity = nx * ny;
-  DisjointSets c_sets(nx * ny + 1);
-  auto both_or_neither = [&](int cx, int cy) { return solid(0, cx, cy) == solid(1, cx, cy); };
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx) {
-      if (!both_or_neither(cx, cy)) continue;
-      const bool in = solid(0, cx, cy);
-      const int c = cy * nx + cx;
-      if (cx + 1 < nx && both_or_neither(cx + 1, cy) && solid(0, cx + 1, cy) == in) c_sets.unite(c, c + 1);
-      if (cy + 1 < ny && both_or_neither(cx, cy + 1) && solid(0, cx, cy + 1) == in) c_sets.unite(c, c + nx);
-      if (!in && (cx == 0 || cy == 0 || cx == nx - 1 || cy == ny - 1)) c_sets.unite(c, infinity);
+  // Bounded components of the complement of X (tiles in both or in neither), each counted for
+  // the component of X that contains the top left corner of its topmost (then leftmost) tile.
+  DisjointSets c_sets(nt + 1);
+  auto both_or_neither = [&](int t) { return t >= 0 && solid(0, t) == solid(1, t); };
+  for (const TileCorner& corner : corners)
+    for (int k = 0; k < 4; ++k) {
+      const int s = corner.around[k], t = corner.around[(k + 1) % 4];
+      if (s != t && both_or_neither(s) && both_or_neither(t) && solid(0, s) == solid(0, t)) c_sets.unite(s, t);
     }
-  std::map<int, int> top_cell;  // complement root -> its topmost (then leftmost) cell
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = nx - 1; cx >= 0; --cx) {
-      if (!both_or_neither(cx, cy)) continue;
-      const int r = c_sets.find(cy * nx + cx);
-      if (r == c_sets.find(infinity)) continue;
-      top_cell[r] = cy * nx + cx;  // later rows and then smaller cx overwrite
+  for (int t = 0; t < nt; ++t) {
+    const QuadCell& c = tiles.cell(t);
+    if (both_or_neither(t) && !solid(0, t) &&
+        (c.x0() == 0 || c.y0() == 0 || c.x1() == kQuadGridSize || c.y1() == kQuadGridSize))
+      c_sets.unite(t, nt);
+  }
+  std::map<int, int> top_tile;  // complement root -> its topmost (then leftmost) tile
+  for (int t = 0; t < nt; ++t) {
+    if (!both_or_neither(t)) continue;
+    const int r = c_sets.find(t);
+    if (r == c_sets.find(nt)) continue;
+    const auto it = top_tile.find(r);
+    const QuadCell& c = tiles.cell(t);
+    if (it == top_tile.end()) {
+      top_tile.emplace(r, t);
+      continue;
     }
+    const QuadCell& best = tiles.cell(it->second);
+    if (c.y1() > best.y1() || (c.y1() == best.y1() && c.x0() < best.x0())) it->second = t;
+  }
   std::map<int, int> holes;  // X root -> bounded complement components it surrounds
-  for (const auto& [root, cell] : top_cell) {
+  for (const auto& [root, t] : top_tile) {
     (void)root;
-    const int cx = cell % nx, cy = cell / nx;
-    ++holes[x_sets.find(vid(cx, cy + 1))];
+    ++holes[x_sets.find(corner_at(tiles.cell(t).x0(), tiles.cell(t).y1()))];
   }
 
   // Pieces of P: components of X, with their loops.
   std::map<int, int> piece_of_root;
-  for (const auto& [contour, v] : contour_root) {
-    const int r = x_sets.find(v);
+  for (const auto& [contour, c] : contour_root) {
+    const int r = x_sets.find(c);
     auto it = piece_of_root.find(r);
     if (it == piece_of_root.end()) {
       it = piece_of_root.emplace(r, static_cast<int>(result.pieces.size())).first;
@@ -256,13 +326,12 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
         if (q.face == r || (q.mixed && q.area_of(r) > 0)) return true;
       return false;
     };
-    for (int cy = 0; cy < ny; ++cy)
-      for (int cx = 0; cx < nx; ++cx) {
-        const int a = raster.leaf_at(0, cx, cy), b = raster.leaf_at(1, cx, cy);
-        if (!present(0, a) || !present(1, b)) continue;
-        if ((*side_leaves[0])[a].mixed) refine[0][a] = 1;
-        if ((*side_leaves[1])[b].mixed) refine[1][b] = 1;
-      }
+    for (int t = 0; t < nt; ++t) {
+      const int a = leaf(0, t), b = leaf(1, t);
+      if (!present(0, a) || !present(1, b)) continue;
+      mark(0, a);
+      mark(1, b);
+    }
   }
   if (unmatched > 0) {
     std::ostringstream message;

@@ -1,10 +1,15 @@
 // The common refinement of one or more quadtrees as a rectilinear grid: the grid lines are the
-// leaf sides of all of them, so every grid cell lies in exactly one leaf of each. Checks and
-// surface extraction run on this grid with plain array code.
+// leaf sides of all of them, so every grid cell lies in exactly one leaf of each. The surface
+// extraction and the coarsening's three-plane check run on this grid with plain array code. The
+// section and slab checks are defined on it too, but run on the leaves (LeafLocator,
+// tile_corners): the grid has (lines)² cells, so a few deep leaves make it huge.
 #pragma once
 
 #include "polycube/quadtree_section.h"
 
+#include <array>
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 namespace polycube {
@@ -32,6 +37,61 @@ QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections);
 // sections' and slabs' checks, which rasterize every time, measured without a clock (the same on
 // every machine and run). build_polycube budgets it (PolycubeOptions::max_rasterized_cells).
 long long& rasterized_cells();
+
+// The grid lines of the leaf sets' common grid, as rasterize gives them (QuadRaster::xs, ys).
+void grid_lines(const std::vector<const std::vector<QuadLeaf>*>& sections, std::vector<int>& xs, std::vector<int>& ys);
+
+// Adds to rasterized_cells() the cells rasterize would fill for these leaf sets, without filling
+// them: checks that look leaves up directly (LeafLocator) charge the work the budget was set in,
+// so a budget stops a build at the same point with or without the raster.
+void charge_raster_cells(const std::vector<const std::vector<QuadLeaf>*>& sections);
+
+// Point location among the leaves of one quadtree, without a raster. The places no leaf covers
+// get filler tiles of the outside face (0), numbered after the leaves, so leaves and fillers
+// tile the unit square. The leaves must not overlap; the locator keeps a reference to them.
+class LeafLocator {
+ public:
+  explicit LeafLocator(const std::vector<QuadLeaf>& leaves);
+
+  // Leaves, then fillers.
+  int size() const { return static_cast<int>(leaves_.size() + fillers_.size()); }
+  const QuadCell& cell(int t) const { return t < leaves() ? leaves_[t].cell : fillers_[t - leaves()]; }
+  int face(int t) const { return t < leaves() ? leaves_[t].face : 0; }
+  int leaves() const { return static_cast<int>(leaves_.size()); }
+  // The tile holding the unit square of the finest grid [ux, ux + 1) x [uy, uy + 1); -1 outside
+  // the unit square.
+  int at(int ux, int uy) const;
+  // The tile holding the finest unit square at grid point (x, y) in direction (sx, sy), each -1
+  // or +1.
+  int beside(int x, int y, int sx, int sy) const { return at(sx < 0 ? x - 1 : x, sy < 0 ? y - 1 : y); }
+  // What a cell of the unit square is: a tile (its index), kSubdivided (tiles lie inside it) or
+  // kInside (it lies inside a tile).
+  static constexpr int kSubdivided = -1, kInside = -2;
+  int find(const QuadCell& cell) const;
+
+ private:
+  static constexpr int kInner = kSubdivided;  // a cell the tiles subdivide
+  static uint64_t key(const QuadCell& c) {
+    return (static_cast<uint64_t>(c.level) << 42) | (static_cast<uint64_t>(c.ix) << 21) | static_cast<uint64_t>(c.iy);
+  }
+  const std::vector<QuadLeaf>& leaves_;
+  std::vector<QuadCell> fillers_;
+  std::unordered_map<uint64_t, int> nodes_;  // every tile and every cell above one: tile index or kInner
+  int deepest_ = 0;
+};
+
+// A corner of a tile and the four tiles around it (SW, SE, NE, NW; -1 outside the unit square).
+// Two tiles that touch meet at a corner of one of them, and every vertex of the common grid that
+// is no tile corner lies inside a tile or inside a side two tiles share: conditions on touching
+// cells are checked on these.
+struct TileCorner {
+  int x = 0;
+  int y = 0;
+  std::array<int, 4> around{};
+};
+
+// Every tile corner once, bottom to top, then left to right (the order of a raster scan).
+std::vector<TileCorner> tile_corners(const LeafLocator& tiles);
 
 // The faces of section s's leaves (its leaf list) on the raster's cells with the padding ring:
 // element (cy + 1) * (nx + 2) + cx + 1 for cell (cx, cy), face 0 (outside) in the padding. For

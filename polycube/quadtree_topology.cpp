@@ -3,6 +3,8 @@
 #include "polycube/disjoint_sets.h"
 #include "polycube/quadtree_raster.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -10,20 +12,22 @@ namespace polycube {
 
 namespace {
 
-// The 4-connected components of equal face among the raster's cells (cell (cx, cy) is element
-// cy * nx + cx); the outside face's cells on the border of the unit square join element nx * ny,
-// which stands for the padding ring.
-template <typename Label>
-DisjointSets face_components(int nx, int ny, const Label& label) {
-  const int border = nx * ny;
-  DisjointSets sets(nx * ny + 1);
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx) {
-      const int f = label(cx, cy), id = cy * nx + cx;
-      if (cx + 1 < nx && label(cx + 1, cy) == f) sets.unite(id, id + 1);
-      if (cy + 1 < ny && label(cx, cy + 1) == f) sets.unite(id, id + nx);
-      if (f == 0 && (cx == 0 || cy == 0 || cx == nx - 1 || cy == ny - 1)) sets.unite(id, border);
+// The 4-connected components of equal face among the tiles: tiles on the two sides of a line at
+// a corner share an edge. The outside face's tiles on the border of the unit square join
+// element tiles.size(), which stands for the padding ring.
+DisjointSets face_components(const LeafLocator& tiles, const std::vector<TileCorner>& corners) {
+  const int nt = tiles.size();
+  DisjointSets sets(nt + 1);
+  for (const TileCorner& corner : corners)
+    for (int k = 0; k < 4; ++k) {
+      const int s = corner.around[k], t = corner.around[(k + 1) % 4];
+      if (s >= 0 && t >= 0 && s != t && tiles.face(s) == tiles.face(t)) sets.unite(s, t);
     }
+  for (int t = 0; t < nt; ++t) {
+    const QuadCell& c = tiles.cell(t);
+    if (tiles.face(t) == 0 && (c.x0() == 0 || c.y0() == 0 || c.x1() == kQuadGridSize || c.y1() == kQuadGridSize))
+      sets.unite(t, nt);
+  }
   return sets;
 }
 
@@ -31,33 +35,30 @@ DisjointSets face_components(int nx, int ny, const Label& label) {
 
 std::string check_section_topology(const PlaneSection& section, const std::vector<QuadLeaf>& leaves,
                                    std::vector<char>& mark) {
-  const QuadRaster raster = rasterize({&leaves});
-  const int nx = raster.nx(), ny = raster.ny(), nf = section.num_faces();
+  charge_raster_cells({&leaves});
+  const LeafLocator tiles(leaves);
+  const int n = tiles.leaves(), nt = tiles.size(), nf = section.num_faces();
   mark.assign(leaves.size(), 0);
   std::string problem;
   auto note = [&](const std::string& text) {
     if (problem.empty()) problem = text;
   };
-  const size_t row = static_cast<size_t>(nx) + 2;
-  const std::vector<int> faces = padded_faces(raster, 0, leaves);
-  auto label = [&](int cx, int cy) { return faces[(cy + 1) * row + cx + 1]; };
-  auto mark_cell = [&](int cx, int cy) {
-    const int l = raster.leaf_at(0, cx, cy);
-    if (l >= 0) mark[l] = 1;
+  auto face = [&](int t) { return t < 0 ? 0 : tiles.face(t); };
+  auto mark_tile = [&](int t) {
+    if (t >= 0 && t < n) mark[t] = 1;
   };
+  const std::vector<TileCorner> corners = tile_corners(tiles);
 
-  // Components of every face (4-connected; the outside joins the padding ring).
-  const int border = nx * ny;
-  DisjointSets sets = face_components(nx, ny, label);
+  // Components of every face (the outside joins the padding ring).
+  DisjointSets sets = face_components(tiles, corners);
   std::vector<int> root(nf, -1);
   std::vector<char> split_face(nf, 0);
-  root[0] = sets.find(border);
-  for (int cy = 0; cy < ny; ++cy)
-    for (int cx = 0; cx < nx; ++cx) {
-      const int f = label(cx, cy), r = sets.find(cy * nx + cx);
-      if (root[f] < 0) root[f] = r;
-      else if (root[f] != r) split_face[f] = 1;
-    }
+  root[0] = sets.find(nt);
+  for (int t = 0; t < nt; ++t) {
+    const int f = face(t), r = sets.find(t);
+    if (root[f] < 0) root[f] = r;
+    else if (root[f] != r) split_face[f] = 1;
+  }
   for (int f = 0; f < nf; ++f) {
     if (root[f] >= 0 && !split_face[f]) continue;
     note(root[f] < 0 ? "face " + std::to_string(f) + " (" + (section.face_solid[f] ? "region" : "hole") +
@@ -68,131 +69,179 @@ std::string check_section_topology(const PlaneSection& section, const std::vecto
   }
 
   // Cells of faces no contour separates must not touch, not even at a corner.
-  const int offsets[4][2] = {{1, 0}, {0, 1}, {1, 1}, {-1, 1}};
-  for (int cy = -1; cy <= ny; ++cy)
-    for (int cx = -1; cx <= nx; ++cx) {
-      const int a = label(cx, cy);
-      for (const auto& d : offsets) {
-        const int ox = cx + d[0], oy = cy + d[1];
-        if (ox < -1 || ox > nx || oy > ny) continue;
-        const int b = label(ox, oy);
+  for (const TileCorner& corner : corners)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const int a = face(corner.around[i]), b = face(corner.around[j]);
         if (a == b || section.contour_between(a, b) >= 0) continue;
-        note("faces " + std::to_string(a) + " and " + std::to_string(b) + " touch");
-        mark_cell(cx, cy);
-        mark_cell(ox, oy);
+        if (problem.empty())
+          problem = "faces " + std::to_string(std::min(a, b)) + " and " + std::to_string(std::max(a, b)) + " touch";
+        mark_tile(corner.around[i]);
+        mark_tile(corner.around[j]);
       }
-    }
 
   // No vertex with solid and empty cells alternating around it.
-  for (int vy = 0; vy <= ny; ++vy)
-    for (int vx = 0; vx <= nx; ++vx) {
-      const bool sw = section.face_solid[label(vx - 1, vy - 1)], se = section.face_solid[label(vx, vy - 1)];
-      const bool ne = section.face_solid[label(vx, vy)], nw = section.face_solid[label(vx - 1, vy)];
-      if (sw == ne && se == nw && sw != se) {
-        note("cells touch diagonally only");
-        mark_cell(vx - 1, vy - 1);
-        mark_cell(vx, vy - 1);
-        mark_cell(vx, vy);
-        mark_cell(vx - 1, vy);
-      }
+  for (const TileCorner& corner : corners) {
+    const auto& a = corner.around;
+    const bool sw = section.face_solid[face(a[0])], se = section.face_solid[face(a[1])];
+    const bool ne = section.face_solid[face(a[2])], nw = section.face_solid[face(a[3])];
+    if (sw == ne && se == nw && sw != se) {
+      note("cells touch diagonally only");
+      for (int t : a) mark_tile(t);
     }
+  }
   return problem;
 }
 
 std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& section,
                                                            const std::vector<QuadLeaf>& leaves) {
-  const QuadRaster raster = rasterize({&leaves});
-  const int nx = raster.nx(), ny = raster.ny();
-  auto leaf_at = [&](int cx, int cy) { return raster.leaf_at(0, cx, cy); };
-  const size_t row = static_cast<size_t>(nx) + 2;
-  const std::vector<int> faces = padded_faces(raster, 0, leaves);
-  auto label = [&](int cx, int cy) { return faces[(cy + 1) * row + cx + 1]; };
-  // Fraction of a cell's leaf covered by face f in truth.
+  // The relabellings are defined on the common grid of the leaves' sides (quadtree_raster.h):
+  // every grid vertex in a raster scan, a leaf keeping the first face it is given. Its vertices
+  // that are no tile corner lie inside a side two tiles share, and repeat that side's contact.
+  charge_raster_cells({&leaves});
+  const LeafLocator tiles(leaves);
+  const int n = tiles.leaves();
+  std::vector<int> xs, ys;
+  grid_lines({&leaves}, xs, ys);
+  auto leaf_of = [&](int t) { return t >= 0 && t < n ? t : -1; };
+  auto label = [&](int t) { return t < 0 ? 0 : tiles.face(t); };
+  // Fraction of a leaf covered by face f in truth.
   auto fraction = [&](int l, int f) {
     if (l < 0) return f == 0 ? 1.0 : 0.0;
     const QuadLeaf& leaf = leaves[l];
     if (!leaf.mixed) return leaf.face == f ? 1.0 : 0.0;
     return leaf.area_of(f) * std::ldexp(1.0, 2 * leaf.cell.level);
   };
+  // (grid vertex y, x, order at the vertex) -> (leaf, face)
+  struct Relabel {
+    int y, x, order, leaf, face;
+  };
+  std::vector<Relabel> found;
+  // Edge contacts between faces no contour separates: the tile with less of its own face takes
+  // the face between them (s first on a tie).
+  auto contact = [&](int y, int x, int order, int s, int t) {
+    const int a = label(s), b = label(t);
+    if (a == b || section.contour_between(a, b) >= 0) return;
+    int between = -1;
+    if (a > 0 && section.contour_between(section.face_parent[a], b) >= 0) between = section.face_parent[a];
+    else if (b > 0 && section.contour_between(section.face_parent[b], a) >= 0) between = section.face_parent[b];
+    if (between < 0) return;
+    const int ls = leaf_of(s), lt = leaf_of(t);
+    found.push_back({y, x, order, fraction(ls, a) <= fraction(lt, b) ? ls : lt, between});
+  };
+  auto on_grid = [](const std::vector<int>& lines, int v) { return std::binary_search(lines.begin(), lines.end(), v); };
+  for (const TileCorner& corner : tile_corners(tiles)) {
+    const int x = corner.x, y = corner.y;
+    if (!on_grid(xs, x) || !on_grid(ys, y)) continue;
+    int lab[4], leaf[4];
+    for (int k = 0; k < 4; ++k) {
+      lab[k] = label(corner.around[k]);
+      leaf[k] = leaf_of(corner.around[k]);
+    }
+    for (int k = 0; k < 2; ++k) {
+      // Solid and empty alternating: join one of the diagonal pairs, through the cell with the
+      // most of the face it takes.
+      const int f = lab[k], g = lab[k + 1];
+      if (lab[k + 2] != f || lab[(k + 3) % 4] != g || section.face_solid[f] == section.face_solid[g]) continue;
+      const int candidates[4][2] = {{leaf[k + 1], f}, {leaf[(k + 3) % 4], f}, {leaf[k], g}, {leaf[k + 2], g}};
+      int best = -1;
+      double most = -1;
+      for (int c = 0; c < 4; ++c) {
+        if (candidates[c][0] < 0) continue;
+        const double share = fraction(candidates[c][0], candidates[c][1]);
+        if (share > most) {
+          most = share;
+          best = c;
+        }
+      }
+      if (best >= 0) found.push_back({y, x, k, candidates[best][0], candidates[best][1]});
+    }
+    // Sides from the vertex: below (SW, SE), right (SE, NE), above (NE, NW), left (NW, SW).
+    for (int k = 0; k < 4; ++k) contact(y, x, 2 + k, corner.around[k], corner.around[(k + 1) % 4]);
+    // The sides starting here to the right and upwards: their first grid vertex inside repeats
+    // the contact, the lower (left) tile first.
+    const int right[2] = {corner.around[1], corner.around[2]}, up[2] = {corner.around[3], corner.around[2]};
+    if (right[0] != right[1]) {
+      int end = kQuadGridSize;
+      for (int t : right)
+        if (t >= 0) end = std::min(end, tiles.cell(t).x1());
+      const auto next = std::upper_bound(xs.begin(), xs.end(), x);
+      if (next != xs.end() && *next < end) {
+        contact(y, *next, 2 + 1, right[0], right[1]);
+        contact(y, *next, 2 + 3, right[1], right[0]);
+      }
+    }
+    if (up[0] != up[1]) {
+      int end = kQuadGridSize;
+      for (int t : up)
+        if (t >= 0) end = std::min(end, tiles.cell(t).y1());
+      const auto next = std::upper_bound(ys.begin(), ys.end(), y);
+      if (next != ys.end() && *next < end) {
+        contact(*next, x, 2 + 0, up[0], up[1]);
+        contact(*next, x, 2 + 2, up[1], up[0]);
+      }
+    }
+  }
+  std::stable_sort(found.begin(), found.end(), [](const Relabel& a, const Relabel& b) {
+    return a.y != b.y ? a.y < b.y : a.x != b.x ? a.x < b.x : a.order < b.order;
+  });
   std::map<int, int> relabel;  // leaf -> face
   auto set = [&](int l, int f) {
     if (l >= 0 && leaves[l].face != f) relabel.emplace(l, f);
   };
+  for (const Relabel& r : found) set(r.leaf, r.face);
 
-  // Diagonal-only touches and forbidden contacts around every vertex.
-  for (int vy = 0; vy <= ny; ++vy)
-    for (int vx = 0; vx <= nx; ++vx) {
-      const int cells[4][2] = {{vx - 1, vy - 1}, {vx, vy - 1}, {vx, vy}, {vx - 1, vy}};  // SW SE NE NW
-      int lab[4], leaf[4];
-      for (int k = 0; k < 4; ++k) {
-        lab[k] = label(cells[k][0], cells[k][1]);
-        leaf[k] = leaf_at(cells[k][0], cells[k][1]);
-      }
-      for (int k = 0; k < 2; ++k) {
-        // Solid and empty alternating: join one of the diagonal pairs, through the cell with
-        // the most of the face it takes.
-        const int f = lab[k], g = lab[k + 1];
-        if (lab[k + 2] != f || lab[(k + 3) % 4] != g || section.face_solid[f] == section.face_solid[g]) continue;
-        const int candidates[4][2] = {{leaf[k + 1], f}, {leaf[(k + 3) % 4], f}, {leaf[k], g}, {leaf[k + 2], g}};
-        int best = -1;
-        double most = -1;
-        for (int c = 0; c < 4; ++c) {
-          if (candidates[c][0] < 0) continue;
-          const double x = fraction(candidates[c][0], candidates[c][1]);
-          if (x > most) {
-            most = x;
-            best = c;
-          }
-        }
-        if (best >= 0) set(candidates[best][0], candidates[best][1]);
-      }
-      // Edge contacts between faces no contour separates: the cell with less of its own face
-      // takes the face between them.
-      for (int k = 0; k < 4; ++k) {
-        const int m = (k + 1) % 4;
-        const int a = lab[k], b = lab[m];
-        if (a == b || section.contour_between(a, b) >= 0) continue;
-        int between = -1;
-        if (a > 0 && section.contour_between(section.face_parent[a], b) >= 0) between = section.face_parent[a];
-        else if (b > 0 && section.contour_between(section.face_parent[b], a) >= 0) between = section.face_parent[b];
-        if (between < 0) continue;
-        if (fraction(leaf[k], a) <= fraction(leaf[m], b)) set(leaf[k], between);
-        else set(leaf[m], between);
-      }
-    }
   if (relabel.empty()) {
-    // Stray components: all but the largest component of each face take their neighbours' face.
-    const int border = nx * ny;
-    DisjointSets sets = face_components(nx, ny, label);
-    std::map<int, int> size;  // root -> cells
-    for (int c = 0; c < nx * ny; ++c) ++size[sets.find(c)];
+    // Stray components: all but the largest component of each face (in grid cells) take their
+    // neighbours' face, by the vote of the four neighbours of the leaf's first grid cell (in a
+    // raster scan) that has a neighbour of another face.
+    const int nt = tiles.size();
+    const std::vector<TileCorner> corners = tile_corners(tiles);
+    DisjointSets sets = face_components(tiles, corners);
+    auto index = [](const std::vector<int>& lines, int v) {
+      return static_cast<int>(std::lower_bound(lines.begin(), lines.end(), v) - lines.begin());
+    };
+    std::map<int, long long> size;  // root -> grid cells
+    for (int t = 0; t < nt; ++t) {
+      const QuadCell& c = tiles.cell(t);
+      size[sets.find(t)] += static_cast<long long>(index(xs, c.x1()) - index(xs, c.x0())) * (index(ys, c.y1()) - index(ys, c.y0()));
+    }
     std::map<int, int> largest;  // face -> its largest root
-    largest[0] = sets.find(border);
+    largest[0] = sets.find(nt);
     for (const auto& [root, count] : size) {
-      if (root == largest[0]) continue;
-      const int f = label(root % nx, root / nx);
-      if (f == 0) continue;
+      if (root == largest[0] || label(root) == 0) continue;
+      const int f = label(root);
       auto it = largest.find(f);
       if (it == largest.end() || count > size[it->second]) largest[f] = root;
     }
-    for (int cy = 0; cy < ny; ++cy)
-      for (int cx = 0; cx < nx; ++cx) {
-        const int f = label(cx, cy);
-        if (sets.find(cy * nx + cx) == largest[f]) continue;
-        std::map<int, int> votes;
-        const int around[4][2] = {{cx - 1, cy}, {cx + 1, cy}, {cx, cy - 1}, {cx, cy + 1}};
-        for (const auto& n : around)
-          if (label(n[0], n[1]) != f) ++votes[label(n[0], n[1])];
-        int best = -1, count = 0;
-        for (const auto& [g, v] : votes)
-          if (v > count) {
-            best = g;
-            count = v;
-          }
-        if (best >= 0) set(leaf_at(cx, cy), best);
-      }
+    for (int l = 0; l < n; ++l) {
+      const int f = label(l);
+      if (sets.find(l) == largest[f]) continue;
+      const QuadCell& c = tiles.cell(l);
+      const int cx0 = index(xs, c.x0()), cx1 = index(xs, c.x1()), cy0 = index(ys, c.y0()), cy1 = index(ys, c.y1());
+      int best = -1;
+      for (int cy = cy0; cy < cy1 && best < 0; ++cy)
+        for (int cx = cx0; cx < cx1 && best < 0; ++cx) {
+          if (cy != cy0 && cy != cy1 - 1 && cx != cx0 && cx != cx1 - 1) cx = cx1 - 1;  // inside the leaf
+          const int around[4] = {cx > cx0 ? f : label(tiles.at(c.x0() - 1, ys[cy])),
+                                 cx < cx1 - 1 ? f : label(tiles.at(c.x1(), ys[cy])),
+                                 cy > cy0 ? f : label(tiles.at(xs[cx], c.y0() - 1)),
+                                 cy < cy1 - 1 ? f : label(tiles.at(xs[cx], c.y1()))};
+          std::map<int, int> votes;
+          for (int g : around)
+            if (g != f) ++votes[g];
+          int count = 0;
+          for (const auto& [g, v] : votes)
+            if (v > count) {
+              best = g;
+              count = v;
+            }
+        }
+      if (best >= 0) set(l, best);
+    }
   }
   return {relabel.begin(), relabel.end()};
 }
+
 
 }  // namespace polycube

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <vector>
 
 namespace polycube {
@@ -94,6 +95,32 @@ TEST(PolycubeSlabCheck, ExtrusionsTouchingAlongAnEdgeAreNotManifold) {
   const auto wider = grid(2, [](int x, int) { return x <= 2; });
   const auto shifted = grid(2, [](int x, int) { return x >= 2; });
   EXPECT_TRUE(check_slab(t.sections, {0, &wider}, {1, &shifted}, t.band).ok());
+}
+
+TEST(PolycubeSlabCheck, NonManifoldVerticesAreCountedOnTheCommonGrid) {
+  // As above, but the lower side's lower left corner is finer: its lines x, y = 1/8, 1/4 cross
+  // the edge x = 1/2 where no cell has a corner. The vertices on it are those of the common grid
+  // of both sides: y = 0, 1/8, 1/4, 1/2, 3/4, 1.
+  const TwoPlanes t;
+  std::vector<QuadLeaf> left;
+  for (const QuadLeaf& leaf : grid(2, [](int x, int) { return x <= 1; })) {
+    if (leaf.cell.ix != 0 || leaf.cell.iy != 0) {
+      left.push_back(leaf);
+      continue;
+    }
+    for (int q = 0; q < 4; ++q) {
+      QuadLeaf child = leaf;
+      child.cell = {3, q & 1, q >> 1};
+      left.push_back(child);
+    }
+  }
+  const auto right = grid(1, [](int x, int) { return x == 1; });
+  const SlabCheck check = check_slab(t.sections, {0, &left}, {1, &right}, t.band);
+  EXPECT_EQ(check.nonmanifold_vertices, 6);
+  ASSERT_EQ(check.nonmanifold.size(), 6u);
+  // At y = 1/8: the leaves on either side of the edge, the lower side's first (SW, SE, NW, NE).
+  const std::array<int, 8> expected = {4, 5, 4, 5, 0, 1, 0, 1};
+  EXPECT_EQ(check.nonmanifold[1], expected);
 }
 
 TEST(PolycubeSlabCheck, DisjointExtrusionsSplitThePiece) {

@@ -17,6 +17,8 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -213,6 +215,65 @@ TEST(QuadtreeSection, SampledSectionFollowsTheContours) {
   EXPECT_NEAR(solid, sections.planes[0].face_area[region], 0.01 * sections.planes[0].face_area[region]);
   std::vector<char> mark;
   EXPECT_EQ(check_section_topology(sections.planes[0], sampled, mark), "");
+}
+
+TEST(QuadtreeSection, LeafLocatorTilesTheSquareWithFillers) {
+  // Leaves over part of the square: the lower left quarter, and three of the four cells of the
+  // lower right quarter's quarters. Fillers (face 0) take the rest.
+  std::vector<QuadLeaf> leaves(4);
+  leaves[0].cell = {1, 0, 0};
+  leaves[0].face = 2;
+  leaves[1].cell = {2, 2, 0};
+  leaves[2].cell = {2, 3, 0};
+  leaves[3].cell = {2, 2, 1};
+  for (int l = 1; l < 4; ++l) leaves[l].face = 1;
+  const LeafLocator tiles(leaves);
+  ASSERT_EQ(tiles.leaves(), 4);
+  ASSERT_EQ(tiles.size(), 7);  // fillers: one cell of level 2, two of level 1
+  std::set<QuadCell> fillers;
+  double area = 0;
+  for (int t = 0; t < tiles.size(); ++t) {
+    area += std::ldexp(1.0, -2 * tiles.cell(t).level);
+    if (t >= tiles.leaves()) {
+      fillers.insert(tiles.cell(t));
+      EXPECT_EQ(tiles.face(t), 0);
+    }
+  }
+  EXPECT_DOUBLE_EQ(area, 1.0);
+  EXPECT_EQ(fillers, (std::set<QuadCell>{{2, 3, 1}, {1, 0, 1}, {1, 1, 1}}));
+  EXPECT_EQ(tiles.face(0), 2);
+
+  const int half = kQuadGridSize / 2, quarter = kQuadGridSize / 4;
+  EXPECT_EQ(tiles.at(0, 0), 0);
+  EXPECT_EQ(tiles.at(half - 1, half - 1), 0);
+  EXPECT_EQ(tiles.at(-1, 0), -1);
+  EXPECT_EQ(tiles.at(0, kQuadGridSize), -1);
+  EXPECT_EQ(tiles.beside(half, half, -1, -1), 0);
+  EXPECT_EQ(tiles.beside(half, half, 1, -1), 3);
+  EXPECT_EQ(tiles.cell(tiles.beside(half, half, 1, 1)), (QuadCell{1, 1, 1}));
+  EXPECT_EQ(tiles.cell(tiles.beside(half, half, -1, 1)), (QuadCell{1, 0, 1}));
+  EXPECT_EQ(tiles.cell(tiles.at(half + quarter, quarter)), (QuadCell{2, 3, 1}));
+  EXPECT_EQ(tiles.find({2, 3, 0}), 2);
+  EXPECT_EQ(tiles.find({1, 1, 0}), LeafLocator::kSubdivided);
+  EXPECT_EQ(tiles.find({3, 0, 0}), LeafLocator::kInside);
+
+  // Every tile corner once, in raster order, with the tiles around it.
+  const std::vector<TileCorner> corners = tile_corners(tiles);
+  std::set<std::pair<int, int>> distinct;
+  for (size_t c = 0; c < corners.size(); ++c) {
+    distinct.insert({corners[c].y, corners[c].x});
+    if (c > 0) EXPECT_LT(std::make_pair(corners[c - 1].y, corners[c - 1].x), std::make_pair(corners[c].y, corners[c].x));
+  }
+  EXPECT_EQ(distinct.size(), corners.size());
+  EXPECT_EQ(corners.size(), 14u);  // the 3 x 3 points of level 1 and 5 more of level 2
+  const auto centre = std::find_if(corners.begin(), corners.end(),
+                                   [&](const TileCorner& c) { return c.x == half && c.y == half; });
+  ASSERT_NE(centre, corners.end());
+  EXPECT_EQ(centre->around[0], 0);
+  EXPECT_EQ(centre->around[1], 3);
+  const auto corner = std::find_if(corners.begin(), corners.end(), [](const TileCorner& c) { return c.x == 0 && c.y == 0; });
+  ASSERT_NE(corner, corners.end());
+  EXPECT_EQ(corner->around, (std::array<int, 4>{-1, -1, 0, -1}));
 }
 
 // The annulus of a torus section, approximated for d_a, then every mixed cell subdivided three
