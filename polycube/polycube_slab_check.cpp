@@ -89,9 +89,9 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
   // on their common refinement: the finer of the two leaves everywhere, each tile inside one
   // leaf (or none) of either side. Grid vertices that are no tile corner lie inside a tile or
   // inside a side two tiles share, and repeat what holds along that side.
-  charge_raster_cells({side_leaves[0], side_leaves[1]});
   std::vector<int> xs, ys;
   grid_lines({side_leaves[0], side_leaves[1]}, xs, ys);
+  charge_raster_cells(xs, ys, 2);
   const LeafLocator side_tiles[2] = {LeafLocator(*side_leaves[0]), LeafLocator(*side_leaves[1])};
   std::vector<QuadLeaf> common;
   std::vector<std::array<int, 2>> common_leaf;  // per tile: the leaf of each side, -1 for none

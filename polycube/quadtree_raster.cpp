@@ -50,40 +50,78 @@ QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections) 
   return raster;
 }
 
-void charge_raster_cells(const std::vector<const std::vector<QuadLeaf>*>& sections) {
-  std::vector<int> xs, ys;
-  grid_lines(sections, xs, ys);
-  rasterized_cells() += static_cast<long long>(xs.size() - 1) * static_cast<long long>(ys.size() - 1) *
-                        static_cast<long long>(sections.size());
+void charge_raster_cells(const std::vector<int>& xs, const std::vector<int>& ys, int sets) {
+  rasterized_cells() += static_cast<long long>(xs.size() - 1) * static_cast<long long>(ys.size() - 1) * sets;
+}
+
+size_t LeafLocator::CellTable::slot(uint64_t key) const {
+  return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - bits_));
+}
+
+void LeafLocator::CellTable::grow() {
+  std::vector<uint64_t> keys = std::move(keys_);
+  std::vector<int> values = std::move(values_);
+  bits_ = std::max(bits_ + 1, 4);
+  keys_.assign(size_t{1} << bits_, kEmpty);
+  values_.assign(size_t{1} << bits_, 0);
+  size_ = 0;
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (keys[i] != kEmpty) insert(keys[i], values[i]);
+}
+
+bool LeafLocator::CellTable::insert(uint64_t key, int value) {
+  if (2 * (size_ + 1) > keys_.size()) grow();
+  const size_t mask = keys_.size() - 1;
+  for (size_t i = slot(key);; i = (i + 1) & mask) {
+    if (keys_[i] == key) return false;
+    if (keys_[i] == kEmpty) {
+      keys_[i] = key;
+      values_[i] = value;
+      ++size_;
+      return true;
+    }
+  }
+}
+
+void LeafLocator::CellTable::assign(uint64_t key, int value) {
+  if (!insert(key, value)) values_[find(key) - values_.data()] = value;
+}
+
+const int* LeafLocator::CellTable::find(uint64_t key) const {
+  if (keys_.empty()) return nullptr;
+  const size_t mask = keys_.size() - 1;
+  for (size_t i = slot(key);; i = (i + 1) & mask) {
+    if (keys_[i] == key) return &values_[i];
+    if (keys_[i] == kEmpty) return nullptr;
+  }
 }
 
 LeafLocator::LeafLocator(const std::vector<QuadLeaf>& leaves) : leaves_(leaves) {
-  nodes_.reserve(2 * leaves.size() + 1);
   for (int l = 0; l < static_cast<int>(leaves.size()); ++l) {
     QuadCell c = leaves[l].cell;
     deepest_ = std::max(deepest_, c.level);
-    nodes_[key(c)] = l;
+    nodes_.assign(key(c), l);
     while (c.level > 0) {
       c = {c.level - 1, c.ix >> 1, c.iy >> 1};
-      if (!nodes_.emplace(key(c), kInner).second) break;
+      if (!nodes_.insert(key(c), kInner)) break;
     }
   }
   // Fillers: the children no tile is in, under every subdivided cell.
   auto add_filler = [&](const QuadCell& c) {
-    nodes_[key(c)] = size();
+    nodes_.assign(key(c), size());
     fillers_.push_back(c);
   };
-  if (nodes_.find(key({})) == nodes_.end()) add_filler({});
+  if (!nodes_.find(key({}))) add_filler({});
   std::vector<QuadCell> inner;
-  if (nodes_.at(key({})) == kInner) inner.push_back({});
+  if (*nodes_.find(key({})) == kInner) inner.push_back({});
   while (!inner.empty()) {
     const QuadCell c = inner.back();
     inner.pop_back();
     for (int q = 0; q < 4; ++q) {
       const QuadCell child{c.level + 1, 2 * c.ix + (q & 1), 2 * c.iy + (q >> 1)};
-      const auto it = nodes_.find(key(child));
-      if (it == nodes_.end()) add_filler(child);
-      else if (it->second == kInner) inner.push_back(child);
+      const int* found = nodes_.find(key(child));
+      if (!found) add_filler(child);
+      else if (*found == kInner) inner.push_back(child);
     }
   }
 }
@@ -91,38 +129,38 @@ LeafLocator::LeafLocator(const std::vector<QuadLeaf>& leaves) : leaves_(leaves) 
 int LeafLocator::at(int ux, int uy) const {
   if (ux < 0 || uy < 0 || ux >= kQuadGridSize || uy >= kQuadGridSize) return -1;
   // The cells holding the unit square exist down to its tile's level: search that level.
-  int lo = 0, hi = deepest_, tile = nodes_.at(key({}));
+  int lo = 0, hi = deepest_, tile = *nodes_.find(key({}));
   while (lo < hi) {
     const int mid = (lo + hi + 1) / 2, shift = kQuadGridBits - mid;
-    const auto it = nodes_.find(key({mid, ux >> shift, uy >> shift}));
-    if (it == nodes_.end()) {
+    const int* found = nodes_.find(key({mid, ux >> shift, uy >> shift}));
+    if (!found) {
       hi = mid - 1;
     } else {
       lo = mid;
-      tile = it->second;
+      tile = *found;
     }
   }
   return tile;
 }
 
 int LeafLocator::find(const QuadCell& cell) const {
-  const auto it = nodes_.find(key(cell));
-  return it == nodes_.end() ? kInside : it->second;
+  const int* found = nodes_.find(key(cell));
+  return found ? *found : kInside;
 }
 
 std::vector<TileCorner> tile_corners(const LeafLocator& tiles) {
-  std::vector<std::pair<int, int>> points;  // (y, x)
+  std::vector<uint64_t> points;  // y << 32 | x: sorted as (y, x)
   points.reserve(4 * static_cast<size_t>(tiles.size()));
   for (int t = 0; t < tiles.size(); ++t) {
     const QuadCell& c = tiles.cell(t);
     for (int y : {c.y0(), c.y1()})
-      for (int x : {c.x0(), c.x1()}) points.emplace_back(y, x);
+      for (int x : {c.x0(), c.x1()}) points.push_back(static_cast<uint64_t>(y) << 32 | static_cast<uint64_t>(x));
   }
   std::sort(points.begin(), points.end());
   points.erase(std::unique(points.begin(), points.end()), points.end());
   std::vector<TileCorner> corners(points.size());
   for (size_t p = 0; p < points.size(); ++p) {
-    const auto [y, x] = points[p];
+    const int y = static_cast<int>(points[p] >> 32), x = static_cast<int>(points[p] & 0xffffffffu);
     corners[p] = {x, y,
                   {tiles.beside(x, y, -1, -1), tiles.beside(x, y, 1, -1), tiles.beside(x, y, 1, 1),
                    tiles.beside(x, y, -1, 1)}};

@@ -9,7 +9,6 @@
 
 #include <array>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 namespace polycube {
@@ -41,10 +40,10 @@ long long& rasterized_cells();
 // The grid lines of the leaf sets' common grid, as rasterize gives them (QuadRaster::xs, ys).
 void grid_lines(const std::vector<const std::vector<QuadLeaf>*>& sections, std::vector<int>& xs, std::vector<int>& ys);
 
-// Adds to rasterized_cells() the cells rasterize would fill for these leaf sets, without filling
-// them: checks that look leaves up directly (LeafLocator) charge the work the budget was set in,
-// so a budget stops a build at the same point with or without the raster.
-void charge_raster_cells(const std::vector<const std::vector<QuadLeaf>*>& sections);
+// Adds to rasterized_cells() the cells rasterize would fill for `sets` leaf sets with these grid
+// lines, without filling them: checks that look leaves up directly (LeafLocator) charge the work
+// the budget was set in, so a budget stops a build at the same point with or without the raster.
+void charge_raster_cells(const std::vector<int>& xs, const std::vector<int>& ys, int sets);
 
 // Point location among the leaves of one quadtree, without a raster. The places no leaf covers
 // get filler tiles of the outside face (0), numbered after the leaves, so leaves and fillers
@@ -74,9 +73,27 @@ class LeafLocator {
   static uint64_t key(const QuadCell& c) {
     return (static_cast<uint64_t>(c.level) << 42) | (static_cast<uint64_t>(c.ix) << 21) | static_cast<uint64_t>(c.iy);
   }
+  // Open addressing with linear probing, cell key -> value: the checks look cells up millions
+  // of times.
+  class CellTable {
+   public:
+    // Inserts key -> value if the key is absent; returns whether it was.
+    bool insert(uint64_t key, int value);
+    void assign(uint64_t key, int value);
+    const int* find(uint64_t key) const;  // null when absent
+
+   private:
+    static constexpr uint64_t kEmpty = ~uint64_t{0};
+    size_t slot(uint64_t key) const;
+    void grow();
+    std::vector<uint64_t> keys_;
+    std::vector<int> values_;
+    size_t size_ = 0;
+    int bits_ = 0;
+  };
   const std::vector<QuadLeaf>& leaves_;
   std::vector<QuadCell> fillers_;
-  std::unordered_map<uint64_t, int> nodes_;  // every tile and every cell above one: tile index or kInner
+  CellTable nodes_;  // every tile and every cell above one: tile index or kInner
   int deepest_ = 0;
 };
 

@@ -35,7 +35,11 @@ DisjointSets face_components(const LeafLocator& tiles, const std::vector<TileCor
 
 std::string check_section_topology(const PlaneSection& section, const std::vector<QuadLeaf>& leaves,
                                    std::vector<char>& mark) {
-  charge_raster_cells({&leaves});
+  {
+    std::vector<int> xs, ys;
+    grid_lines({&leaves}, xs, ys);
+    charge_raster_cells(xs, ys, 1);
+  }
   const LeafLocator tiles(leaves);
   const int n = tiles.leaves(), nt = tiles.size(), nf = section.num_faces();
   mark.assign(leaves.size(), 0);
@@ -98,11 +102,11 @@ std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& s
   // The relabellings are defined on the common grid of the leaves' sides (quadtree_raster.h):
   // every grid vertex in a raster scan, a leaf keeping the first face it is given. Its vertices
   // that are no tile corner lie inside a side two tiles share, and repeat that side's contact.
-  charge_raster_cells({&leaves});
-  const LeafLocator tiles(leaves);
-  const int n = tiles.leaves();
   std::vector<int> xs, ys;
   grid_lines({&leaves}, xs, ys);
+  charge_raster_cells(xs, ys, 1);
+  const LeafLocator tiles(leaves);
+  const int n = tiles.leaves();
   auto leaf_of = [&](int t) { return t >= 0 && t < n ? t : -1; };
   auto label = [&](int t) { return t < 0 ? 0 : tiles.face(t); };
   // Fraction of a leaf covered by face f in truth.

@@ -262,7 +262,9 @@ TEST(QuadtreeSection, LeafLocatorTilesTheSquareWithFillers) {
   std::set<std::pair<int, int>> distinct;
   for (size_t c = 0; c < corners.size(); ++c) {
     distinct.insert({corners[c].y, corners[c].x});
-    if (c > 0) EXPECT_LT(std::make_pair(corners[c - 1].y, corners[c - 1].x), std::make_pair(corners[c].y, corners[c].x));
+    if (c > 0) {
+      EXPECT_LT(std::make_pair(corners[c - 1].y, corners[c - 1].x), std::make_pair(corners[c].y, corners[c].x));
+    }
   }
   EXPECT_EQ(distinct.size(), corners.size());
   EXPECT_EQ(corners.size(), 14u);  // the 3 x 3 points of level 1 and 5 more of level 2
