@@ -132,21 +132,7 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
     if (result.problem.empty()) result.problem = text;
   };
   auto on_grid = [](const std::vector<int>& lines, int v) { return std::binary_search(lines.begin(), lines.end(), v); };
-  // Per corner, the sides starting there to the right (tiles below, above) and upwards (left,
-  // right), their far end, and the grid lines strictly inside them.
-  struct Side {
-    int from = 0, to = 0;  // tiles, from below (left)
-    int end = 0;           // x (y) of the far end
-  };
-  auto side_from = [&](const TileCorner& corner, bool upwards) {
-    Side side;
-    side.from = upwards ? corner.around[3] : corner.around[1];
-    side.to = corner.around[2];
-    side.end = kQuadGridSize;
-    for (int t : {side.from, side.to})
-      if (t >= 0) side.end = std::min(side.end, upwards ? tiles.cell(t).y1() : tiles.cell(t).x1());
-    return side;
-  };
+  // The grid lines strictly inside a side (from, to).
   auto lines_inside = [](const std::vector<int>& lines, int from, int to) {
     return std::make_pair(std::upper_bound(lines.begin(), lines.end(), from), std::lower_bound(lines.begin(), lines.end(), to));
   };
@@ -171,7 +157,7 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
   for (const TileCorner& corner : corners) {
     const auto& a = corner.around;
     if (on_grid(xs, corner.x) && on_grid(ys, corner.y)) check_vertex(corner.x, corner.y, {a[0], a[1], a[3], a[2]});
-    const Side right = side_from(corner, false), up = side_from(corner, true);
+    const TileSide right = side_from(tiles, corner, false), up = side_from(tiles, corner, true);
     if (right.from != right.to) {
       const auto [first, last] = lines_inside(xs, corner.x, right.end);
       for (auto x = first; x < last; ++x) check_vertex(*x, corner.y, {right.from, right.from, right.to, right.to});
@@ -209,7 +195,7 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
   bool loops_consistent = true;
   for (int c = 0; c < nc; ++c)
     for (bool upwards : {false, true}) {
-      const Side side = side_from(corners[c], upwards);
+      const TileSide side = side_from(tiles, corners[c], upwards);
       if (side.from == side.to) continue;
       const int far = upwards ? corner_at(corners[c].x, side.end) : corner_at(side.end, corners[c].y);
       for (int s = 0; s < 2; ++s) {

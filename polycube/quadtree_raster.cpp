@@ -168,6 +168,16 @@ std::vector<TileCorner> tile_corners(const LeafLocator& tiles) {
   return corners;
 }
 
+TileSide side_from(const LeafLocator& tiles, const TileCorner& corner, bool upwards) {
+  TileSide side;
+  side.from = upwards ? corner.around[3] : corner.around[1];
+  side.to = corner.around[2];
+  side.end = kQuadGridSize;
+  for (int t : {side.from, side.to})
+    if (t >= 0) side.end = std::min(side.end, upwards ? tiles.cell(t).y1() : tiles.cell(t).x1());
+  return side;
+}
+
 std::vector<int> padded_faces(const QuadRaster& raster, int s, const std::vector<QuadLeaf>& leaves) {
   const int nx = raster.nx(), ny = raster.ny(), row = nx + 2;
   std::vector<int> faces(static_cast<size_t>(row) * (ny + 2), 0);

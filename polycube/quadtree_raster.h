@@ -110,6 +110,16 @@ struct TileCorner {
 // Every tile corner once, bottom to top, then left to right (the order of a raster scan).
 std::vector<TileCorner> tile_corners(const LeafLocator& tiles);
 
+// The side two tiles share from a corner to the right (the tiles below and above it) or
+// upwards (left and right of it), up to the next tile corner on it: x (y) of its far end. The
+// two tiles are equal where there is no side; -1 outside the unit square.
+struct TileSide {
+  int from = 0;  // the tile below (left)
+  int to = 0;    // the tile above (right)
+  int end = 0;
+};
+TileSide side_from(const LeafLocator& tiles, const TileCorner& corner, bool upwards);
+
 // The faces of section s's leaves (its leaf list) on the raster's cells with the padding ring:
 // element (cy + 1) * (nx + 2) + cx + 1 for cell (cx, cy), face 0 (outside) in the padding. For
 // checks that look up neighbouring cells many times.

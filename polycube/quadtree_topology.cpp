@@ -164,26 +164,16 @@ std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& s
     for (int k = 0; k < 4; ++k) contact(y, x, 2 + k, corner.around[k], corner.around[(k + 1) % 4]);
     // The sides starting here to the right and upwards: their first grid vertex inside repeats
     // the contact, the lower (left) tile first.
-    const int right[2] = {corner.around[1], corner.around[2]}, up[2] = {corner.around[3], corner.around[2]};
-    if (right[0] != right[1]) {
-      int end = kQuadGridSize;
-      for (int t : right)
-        if (t >= 0) end = std::min(end, tiles.cell(t).x1());
-      const auto next = std::upper_bound(xs.begin(), xs.end(), x);
-      if (next != xs.end() && *next < end) {
-        contact(y, *next, 2 + 1, right[0], right[1]);
-        contact(y, *next, 2 + 3, right[1], right[0]);
-      }
-    }
-    if (up[0] != up[1]) {
-      int end = kQuadGridSize;
-      for (int t : up)
-        if (t >= 0) end = std::min(end, tiles.cell(t).y1());
-      const auto next = std::upper_bound(ys.begin(), ys.end(), y);
-      if (next != ys.end() && *next < end) {
-        contact(*next, x, 2 + 0, up[0], up[1]);
-        contact(*next, x, 2 + 2, up[1], up[0]);
-      }
+    for (bool upwards : {false, true}) {
+      const TileSide side = side_from(tiles, corner, upwards);
+      if (side.from == side.to) continue;
+      const std::vector<int>& lines = upwards ? ys : xs;
+      const auto next = std::upper_bound(lines.begin(), lines.end(), upwards ? y : x);
+      if (next == lines.end() || *next >= side.end) continue;
+      const int vy = upwards ? *next : y, vx = upwards ? x : *next;
+      // Right: (SE, NE) then (NW, SW) there; upwards: (SW, SE) then (NE, NW).
+      contact(vy, vx, upwards ? 2 + 0 : 2 + 1, side.from, side.to);
+      contact(vy, vx, upwards ? 2 + 2 : 2 + 3, side.to, side.from);
     }
   }
   std::stable_sort(found.begin(), found.end(), [](const Relabel& a, const Relabel& b) {
