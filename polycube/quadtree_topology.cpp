@@ -134,7 +134,8 @@ std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& s
     found.push_back({y, x, order, fraction(ls, a) <= fraction(lt, b) ? ls : lt, between});
   };
   auto on_grid = [](const std::vector<int>& lines, int v) { return std::binary_search(lines.begin(), lines.end(), v); };
-  for (const TileCorner& corner : tile_corners(tiles)) {
+  const std::vector<TileCorner> corners = tile_corners(tiles);
+  for (const TileCorner& corner : corners) {
     const int x = corner.x, y = corner.y;
     if (!on_grid(xs, x) || !on_grid(ys, y)) continue;
     int lab[4], leaf[4];
@@ -190,7 +191,6 @@ std::vector<std::pair<int, int>> section_topology_relabels(const PlaneSection& s
     // neighbours' face, by the vote of the four neighbours of the leaf's first grid cell (in a
     // raster scan) that has a neighbour of another face.
     const int nt = tiles.size();
-    const std::vector<TileCorner> corners = tile_corners(tiles);
     DisjointSets sets = face_components(tiles, corners);
     auto index = [](const std::vector<int>& lines, int v) {
       return static_cast<int>(std::lower_bound(lines.begin(), lines.end(), v) - lines.begin());
