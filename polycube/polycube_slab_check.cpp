@@ -213,19 +213,11 @@ SlabCheck check_slab(const CrossSections& sections, const SlabSide& lo, const Sl
 
   // Bounded components of the complement of X (tiles in both or in neither), each counted for
   // the component of X that contains the top left corner of its topmost (then leftmost) tile.
-  DisjointSets c_sets(nt + 1);
   auto both_or_neither = [&](int t) { return t >= 0 && solid(0, t) == solid(1, t); };
-  for (const TileCorner& corner : corners)
-    for (int k = 0; k < 4; ++k) {
-      const int s = corner.around[k], t = corner.around[(k + 1) % 4];
-      if (s != t && both_or_neither(s) && both_or_neither(t) && solid(0, s) == solid(0, t)) c_sets.unite(s, t);
-    }
-  for (int t = 0; t < nt; ++t) {
-    const QuadCell& c = tiles.cell(t);
-    if (both_or_neither(t) && !solid(0, t) &&
-        (c.x0() == 0 || c.y0() == 0 || c.x1() == kQuadGridSize || c.y1() == kQuadGridSize))
-      c_sets.unite(t, nt);
-  }
+  DisjointSets c_sets = tile_components(
+      tiles, corners,
+      [&](int s, int t) { return both_or_neither(s) && both_or_neither(t) && solid(0, s) == solid(0, t); },
+      [&](int t) { return both_or_neither(t) && !solid(0, t); });
   std::map<int, int> top_tile;  // complement root -> its topmost (then leftmost) tile
   for (int t = 0; t < nt; ++t) {
     if (!both_or_neither(t)) continue;

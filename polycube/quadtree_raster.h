@@ -5,6 +5,7 @@
 // tile_corners): the grid has (lines)² cells, so a few deep leaves make it huge.
 #pragma once
 
+#include "polycube/disjoint_sets.h"
 #include "polycube/quadtree_section.h"
 
 #include <array>
@@ -109,6 +110,27 @@ struct TileCorner {
 
 // Every tile corner once, bottom to top, then left to right (the order of a raster scan).
 std::vector<TileCorner> tile_corners(const LeafLocator& tiles);
+
+// The components of the tiles where `joined(s, t)` holds for tiles that share an edge (the
+// tiles on the two sides of a line at a corner), the tiles on the border of the unit square
+// where `open(t)` holds joining element tiles.size(), which stands for the padding ring.
+template <typename Joined, typename Open>
+DisjointSets tile_components(const LeafLocator& tiles, const std::vector<TileCorner>& corners, const Joined& joined,
+                             const Open& open) {
+  const int nt = tiles.size();
+  DisjointSets sets(nt + 1);
+  for (const TileCorner& corner : corners)
+    for (int k = 0; k < 4; ++k) {
+      const int s = corner.around[k], t = corner.around[(k + 1) % 4];
+      if (s >= 0 && t >= 0 && s != t && joined(s, t)) sets.unite(s, t);
+    }
+  for (int t = 0; t < nt; ++t) {
+    const QuadCell& c = tiles.cell(t);
+    if (open(t) && (c.x0() == 0 || c.y0() == 0 || c.x1() == kQuadGridSize || c.y1() == kQuadGridSize))
+      sets.unite(t, nt);
+  }
+  return sets;
+}
 
 // The side two tiles share from a corner to the right (the tiles below and above it) or
 // upwards (left and right of it), up to the next tile corner on it: x (y) of its far end. The

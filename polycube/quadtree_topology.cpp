@@ -12,23 +12,12 @@ namespace polycube {
 
 namespace {
 
-// The 4-connected components of equal face among the tiles: tiles on the two sides of a line at
-// a corner share an edge. The outside face's tiles on the border of the unit square join
-// element tiles.size(), which stands for the padding ring.
+// The 4-connected components of equal face among the tiles; the outside face's tiles on the
+// border of the unit square join element tiles.size(), which stands for the padding ring.
 DisjointSets face_components(const LeafLocator& tiles, const std::vector<TileCorner>& corners) {
-  const int nt = tiles.size();
-  DisjointSets sets(nt + 1);
-  for (const TileCorner& corner : corners)
-    for (int k = 0; k < 4; ++k) {
-      const int s = corner.around[k], t = corner.around[(k + 1) % 4];
-      if (s >= 0 && t >= 0 && s != t && tiles.face(s) == tiles.face(t)) sets.unite(s, t);
-    }
-  for (int t = 0; t < nt; ++t) {
-    const QuadCell& c = tiles.cell(t);
-    if (tiles.face(t) == 0 && (c.x0() == 0 || c.y0() == 0 || c.x1() == kQuadGridSize || c.y1() == kQuadGridSize))
-      sets.unite(t, nt);
-  }
-  return sets;
+  return tile_components(
+      tiles, corners, [&](int s, int t) { return tiles.face(s) == tiles.face(t); },
+      [&](int t) { return tiles.face(t) == 0; });
 }
 
 }  // namespace
