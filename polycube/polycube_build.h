@@ -43,8 +43,8 @@ struct PolycubeOptions {
   int max_inserted_planes = 400;
   // Check-and-repair rounds before giving up.
   int max_rounds = 80;
-  // Most grid cells the checks may rasterize in total (quadtree_raster.h: their work, without a
-  // clock) before giving up; 0: no limit. A scoring budget for orientations whose sections are
+  // Most common-grid cells the checks may cover in total (quadtree_raster.h, rasterized_cells:
+  // their work, without a clock) before giving up; 0: no limit. A scoring budget for orientations whose sections are
   // costly to check (a box with holes turned off its axes: minutes per candidate).
   double max_rasterized_cells = 0;
   // Thinnest slab, as a fraction of the model's height, that may still get a plane inserted.

@@ -33,9 +33,10 @@ struct QuadRaster {
 // Rasterizes the leaf sets (each covering the unit square) on their common grid.
 QuadRaster rasterize(const std::vector<const std::vector<QuadLeaf>*>& sections);
 
-// Grid cells (nx × ny per leaf set) rasterize has filled on this thread so far: the work of the
-// sections' and slabs' checks, which rasterize every time, measured without a clock (the same on
-// every machine and run). build_polycube budgets it (PolycubeOptions::max_rasterized_cells).
+// Grid cells (nx × ny per leaf set) of the common grids rasterize has filled or the section and
+// slab checks have charged (charge_raster_cells: they run on the leaves) on this thread so far:
+// the checks' work measured without a clock (the same on every machine and run), in the unit it
+// had when they filled the grid. build_polycube budgets it (PolycubeOptions::max_rasterized_cells).
 long long& rasterized_cells();
 
 // The grid lines of the leaf sets' common grid, as rasterize gives them (QuadRaster::xs, ys).
