@@ -110,7 +110,16 @@ PolygonSoup read_polygon_soup(const std::string& path) {
   else
     fail(path, "unsupported format '" + extension + "' (supported: .obj .off .ply .stl)");
 
-  PolygonSoup soup = reader(path, load_file(path));
+  std::string bytes = load_file(path);
+  // A byte-order mark at the start of a text format: UTF-8's is dropped (Windows editors write
+  // it), UTF-16 text is refused by name. (A binary STL's header is free-form: its bytes are left.)
+  if (extension != ".stl") {
+    if (bytes.rfind("\xFF\xFE", 0) == 0 || bytes.rfind("\xFE\xFF", 0) == 0)
+      fail(path, "UTF-16 text (byte-order mark " + std::string(bytes[0] == '\xFF' ? "FF FE" : "FE FF") +
+                     "): save the file as ASCII or UTF-8");
+    if (bytes.rfind("\xEF\xBB\xBF", 0) == 0) bytes.erase(0, 3);
+  }
+  PolygonSoup soup = reader(path, bytes);
   validate(path, soup);
   return soup;
 }

@@ -156,9 +156,10 @@ PlyHeader parse_header(const std::string& path, const std::string& bytes) {
         if (element.properties.empty() && element.count > 0)
           fail(path,
                "element '" + element.name + "' has " + std::to_string(element.count) + " items but no properties");
-    } else if (keyword != "comment" && keyword != "obj_info") {
-      fail_at(path, number, "unknown header keyword " + quote(keyword));
     }
+    // Any other line is free text, as CGAL's reader takes it: comment and obj_info, and lines
+    // the format does not define, such as the "Created by Blender3D ..." line Blender 2.4x wrote
+    // without a comment keyword. Such a line cannot declare an element or property of its own.
   }
   if (!ended) fail(path, "truncated: the header has no end_header line");
   header.lines = lines.line_number();

@@ -36,12 +36,16 @@ float read_float_le(const std::string& bytes, std::size_t offset) {
   return value;
 }
 
-// Whether CGAL would take the file for ASCII: "solid" after leading whitespace, then a separator.
-bool starts_with_solid(const std::string& bytes) {
-  const std::size_t first = bytes.find_first_not_of(" \t\r\n\v\f");
-  if (first == std::string::npos || bytes.compare(first, 5, "solid") != 0) return false;
+constexpr const char* kWhitespace = " \t\r\n\v\f";
+
+// Where "solid" followed by whitespace (or the end) starts after leading whitespace: the start of
+// an ASCII file (npos: none). CGAL takes only ' ', '\n' and '\r' after it for ASCII at once;
+// "solid\t..." it parses as binary first (read_stl gives it a space instead).
+std::size_t solid_at(const std::string& bytes) {
+  const std::size_t first = bytes.find_first_not_of(kWhitespace);
+  if (first == std::string::npos || bytes.compare(first, 5, "solid") != 0) return std::string::npos;
   const std::size_t after = first + 5;
-  return after == bytes.size() || bytes[after] == ' ' || bytes[after] == '\n' || bytes[after] == '\r';
+  return after == bytes.size() || std::strchr(kWhitespace, bytes[after]) ? first : std::string::npos;
 }
 
 void check_binary(const std::string& path, const std::string& bytes) {
@@ -113,7 +117,8 @@ PolygonSoup read_stl(const std::string& path, const std::string& bytes) {
   if (is_blank(bytes)) fail(path, "file is empty");
   // A binary file has exactly the size its triangle count announces; only files that do not,
   // and start with "solid", are ASCII.
-  bool binary = !starts_with_solid(bytes);
+  const std::size_t solid = solid_at(bytes);
+  bool binary = solid == std::string::npos;
   if (bytes.size() >= binary_header_size &&
       bytes.size() == binary_header_size + std::uint64_t{read_u32_le(bytes, 80)} * binary_triangle_size)
     binary = true;
@@ -126,11 +131,18 @@ PolygonSoup read_stl(const std::string& path, const std::string& bytes) {
     std::fill(data.begin(), data.begin() + 80, '\0');
   } else {
     check_ascii(path, bytes);
+    // "solid" then a tab (or another whitespace CGAL does not take): a space instead, so that
+    // CGAL parses the text as text.
+    const std::size_t after = solid + 5;
+    if (after < bytes.size() && bytes[after] != ' ' && bytes[after] != '\n' && bytes[after] != '\r') {
+      data = bytes;
+      data[after] = ' ';
+    }
   }
 
   std::vector<std::array<double, 3>> points;
   std::vector<std::array<int, 3>> triangles;
-  std::istringstream in(binary ? data : bytes, std::ios::in | std::ios::binary);
+  std::istringstream in(data.empty() ? bytes : data, std::ios::in | std::ios::binary);
   if (!CGAL::IO::read_STL(in, points, triangles, CGAL::parameters::verbose(false)))
     fail(path, std::string("malformed ") + (binary ? "binary" : "ASCII") + " STL (CGAL's reader failed)");
 

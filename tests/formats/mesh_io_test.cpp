@@ -296,6 +296,26 @@ TEST(StlRead, AsciiIsIndexed) {
   expect_indexed_tetrahedron(read_polygon_soup(test::write_file(test::temp_dir("stl") + "/tetra.stl", text)));
 }
 
+// The ASCII tetrahedron with `after_solid` between "solid" and its name.
+std::string ascii_tetrahedron(const std::string& after_solid) {
+  std::string text = "solid" + after_solid + "tetra\n";
+  for (const auto& t : tetrahedron_triangles()) {
+    text += "  facet normal 0 0 0\n    outer loop\n";
+    for (int c = 0; c < 3; ++c)
+      text += "      vertex " + std::to_string(t[3 * c]) + " " + std::to_string(t[3 * c + 1]) + " " + std::to_string(t[3 * c + 2]) + "\n";
+    text += "    endloop\n  endfacet\n";
+  }
+  return text + "endsolid tetra\n";
+}
+
+// "solid" then a tab (assimp's sphereWithHole.stl): text, not a binary file announcing
+// 1 953 654 134 triangles (the bytes "vert" read as a count).
+TEST(StlRead, AsciiWithATabAfterSolid) {
+  const std::string dir = test::temp_dir("stl");
+  expect_indexed_tetrahedron(read_polygon_soup(test::write_file(dir + "/tab.stl", ascii_tetrahedron("\t"))));
+  expect_indexed_tetrahedron(read_polygon_soup(test::write_file(dir + "/tabs.stl", "\t" + ascii_tetrahedron("\t\t"))));
+}
+
 TEST(StlRead, AsciiErrorsHaveLineNumbers) {
   const std::string dir = test::temp_dir("stl");
   const std::string head = "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n";
@@ -370,6 +390,41 @@ TEST(BinaryRead, UnsupportedPlyHeadersAreInputErrors) {
   expect_input_error(test::write_file(dir + "/points.ply", vertex + "property float x\nproperty float y\nproperty float z\n"
                                                        "end_header\n0 0 0\n0 0 1\n0 1 0\n"),
                      "no face element");
+}
+
+// Header lines the format does not define are free text, as for CGAL's reader: Blender 2.4x
+// wrote "Created by Blender3D ..." without a comment keyword (assimp's Wuson.ply).
+TEST(PlyRead, UndefinedHeaderLinesAreFreeText) {
+  const std::string path = test::write_file(test::temp_dir("ply") + "/blender.ply",
+                                            "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org, source file: \n"
+                                            "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                            "element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
+                                            "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const PolygonSoup soup = read_polygon_soup(path);
+  ASSERT_EQ(soup.points.size(), 3u);
+  EXPECT_EQ(soup.points[1], Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(soup.polygons, (std::vector<std::vector<int>>{{0, 1, 2}}));
+}
+
+// A UTF-8 byte-order mark before a text format is dropped (Windows editors write one); UTF-16
+// text is refused by name, not as "not an OBJ file" with garbled characters.
+TEST(TextRead, ByteOrderMarks) {
+  const std::string dir = test::temp_dir("bom");
+  const std::string bom = "\xEF\xBB\xBF";
+  const std::string off = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"a.off", off}, {"a.obj", obj}, {"a.ply", ply}}) {
+    const PolygonSoup soup = read_polygon_soup(test::write_file(dir + "/" + name, bom + text));
+    ASSERT_EQ(soup.points.size(), 3u) << name;
+    EXPECT_EQ(soup.points[2], Eigen::Vector3d(0, 1, 0)) << name;
+    EXPECT_EQ(soup.polygons, (std::vector<std::vector<int>>{{0, 1, 2}})) << name;
+  }
+  // "OFF\n" in UTF-16, little- and big-endian.
+  expect_input_error(test::write_file(dir + "/le.off", std::string("\xFF\xFEO\0F\0F\0\n\0", 10)), "UTF-16 text (byte-order mark FF FE)");
+  expect_input_error(test::write_file(dir + "/be.obj", std::string("\xFE\xFF\0v\0 \0" "0", 8)), "UTF-16 text (byte-order mark FE FF)");
+  expect_input_error(test::write_file(dir + "/only.off", bom), "file is empty");
 }
 
 TEST(BinaryRead, AsciiPlyErrorsHaveLineNumbers) {
