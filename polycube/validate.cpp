@@ -344,6 +344,11 @@ int orient_outward(TriMesh& mesh) {
   return flipped;
 }
 
+// A closed surface enclosing at most this times its bounding-box diagonal cubed lies on itself
+// (a sheet closed by --fill-holes onto its own back, a flat pillow): no cross-section of it has
+// an inside. A plate 1 × 1 × 0.001 encloses 3.5e-4 of its diagonal cubed.
+constexpr double kFlatVolume = 1e-9;
+
 int count_collinear_faces(const TriMesh& mesh) {
   int count = 0;
   for (int f = 0; f < mesh.num_faces(); ++f) {
@@ -542,11 +547,14 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   d.bbox.min += result.offset;  // the input's
   d.bbox.max += result.offset;
 
+  double volume = std::numeric_limits<double>::quiet_NaN();  // of a closed, outward mesh
   if (d.manifold() && d.orientable) {
     d.genus = genus(mesh.F, mesh.num_vertices());
-    if (d.closed())
+    if (d.closed()) {
       if (const int flipped = orient_outward(mesh); flipped > 0)
         result.repairs.push_back("reversed the orientation of " + plural(flipped, "face") + " to face outward");
+      volume = signed_volume(mesh);
+    }
     if (options.check_self_intersections) {
       d.self_intersections = static_cast<int>(self_intersecting_faces(mesh).size());
     }
@@ -556,7 +564,8 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   if (d.faces == 0) d.problems.push_back("no faces of non-zero area");
   // Squared areas and lengths must stay normal doubles (a coordinate of 1e300: the diagonal is
   // infinite and every later stage divides by it).
-  if (d.faces > 0 && !(d.bbox.diagonal() >= kSmallestDiagonal && d.bbox.diagonal() <= kLargestDiagonal)) {
+  const bool size_in_range = d.bbox.diagonal() >= kSmallestDiagonal && d.bbox.diagonal() <= kLargestDiagonal;
+  if (d.faces > 0 && !size_in_range) {
     std::ostringstream size;
     size << "bounding-box diagonal " << d.bbox.diagonal() << " is outside " << kSmallestDiagonal << " .. " << kLargestDiagonal
          << " (scale the model)";
@@ -576,6 +585,8 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
   if (d.components > 1)
     d.problems.push_back(plural(d.components, "connected component") + " (--largest-component keeps the largest)");
   if (d.degenerate_faces > 0) d.problems.push_back(plural(d.degenerate_faces, "zero-area face") + " that could not be removed");
+  if (d.faces > 0 && size_in_range && volume <= kFlatVolume * std::pow(d.bbox.diagonal(), 3))
+    d.problems.push_back("the closed surface encloses no volume (its sides lie on each other: a flat or doubled sheet)");
   if (d.self_intersections > 0)
     d.warnings.push_back(plural(d.self_intersections, "pair") + " of self-intersecting faces (tolerated: the map is intrinsic)");
   return result;

@@ -261,6 +261,25 @@ TEST(Validate, OnlyZeroAreaFacesIsNotMappable) {
   }
 }
 
+// A closed surface whose sides lie on each other (a tetrahedron pressed flat: four faces of
+// non-zero area, closed, manifold, genus 0) encloses no volume and is refused by name; a thin
+// plate still encloses one and is valid.
+TEST(Validate, AClosedSurfaceEnclosingNoVolumeIsNotMappable) {
+  PolygonSoup flat = tetrahedron();
+  flat.points[3] = Eigen::Vector3d(0.25, 0.25, 0);
+  const PreparedMesh pressed = prepare_mesh(flat);
+  EXPECT_TRUE(pressed.diagnosis.closed());
+  EXPECT_EQ(pressed.diagnosis.genus, 0);
+  ASSERT_FALSE(pressed.diagnosis.valid());
+  EXPECT_NE(pressed.diagnosis.problems.back().find("encloses no volume"), std::string::npos) << pressed.diagnosis.problems.back();
+  EXPECT_THROW(require_mappable(pressed.diagnosis), MeshError);
+
+  PolygonSoup plate = cube_quads();
+  for (Eigen::Vector3d& p : plate.points) p.z() *= 1e-3;
+  const PreparedMesh thin = prepare_mesh(plate);
+  EXPECT_TRUE(thin.diagnosis.valid()) << (thin.diagnosis.problems.empty() ? "" : thin.diagnosis.problems.front());
+}
+
 // A model so large or so small that its squared areas leave the doubles is refused with its size;
 // within the range it is valid.
 TEST(Validate, ModelsBeyondTheDoublesRangeAreNotMappable) {
