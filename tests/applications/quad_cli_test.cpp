@@ -502,6 +502,34 @@ TEST(QuadCli, QuadsOfASelfIntersectingModelLieOnTheModel) {
   EXPECT_FALSE(nlohmann::json::parse(test::read_file(own_report)).contains("separation"));
 }
 
+// Through `map`'s directory the model is not split (that map is of the model as read): on a
+// tetrahedron of 4 triangles the quads miss the model by about 12 % of the diagonal, and the
+// warning says what `quad` without --map does instead. Without --map the split is made and the
+// quads meet the bound.
+TEST(QuadCli, MapDirectoryOfACoarseModelSaysTheSplitIsNotMade) {
+  const std::string dir = test::temp_dir("quad-cli");
+  const std::string mesh = quoted(test::data_path("tetrahedron.off"));
+  ASSERT_EQ(polycube_cli("map " + mesh + " -o " + quoted(dir + "/map") + " --quiet").code, 0);
+  const std::string report_path = dir + "/report.json";
+  const test::CliRun through = polycube_cli("quad " + mesh + " --map " + quoted(dir + "/map") + " -o " + quoted(dir + "/q.obj") +
+                                            " --report " + quoted(report_path));
+  ASSERT_EQ(through.code, 0) << through.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(report_path));
+  EXPECT_GT(report["quality"]["hausdorff_percent_diagonal"].get<double>(), 0.5);
+  const std::string warnings = report["warnings"].dump();
+  EXPECT_NE(warnings.find("with --map the model's long edges are not split (6 edges longer than --split-edges 2 times the quad size)"),
+            std::string::npos)
+      << warnings;
+  EXPECT_NE(through.err.find("without --map they are"), std::string::npos) << through.err;
+
+  const test::CliRun split = polycube_cli("quad " + mesh + " -o " + quoted(dir + "/q.obj") + " --report " + quoted(report_path) + " --quiet");
+  ASSERT_EQ(split.code, 0) << split.err;
+  const nlohmann::json own = nlohmann::json::parse(test::read_file(report_path));
+  EXPECT_GT(own["split"]["rounds"].get<int>(), 0);
+  EXPECT_LE(own["quality"]["hausdorff_percent_diagonal"].get<double>(), 0.5);
+  EXPECT_EQ(own["warnings"].dump().find("--map"), std::string::npos) << own["warnings"].dump();
+}
+
 TEST(QuadCli, CleanErrors) {
   const std::string dir = test::temp_dir("quad-cli");
   const std::string mesh = quoted(test::data_path("eight.off"));
