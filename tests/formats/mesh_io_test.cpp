@@ -29,6 +29,14 @@ std::vector<std::string> entries(const std::string& dir) {
   return names;
 }
 
+// Expects soup to hold `points` points, point `at` equal to `point`, and exactly `polygons`.
+void expect_soup(const PolygonSoup& soup, std::size_t points, int at, const Eigen::Vector3d& point,
+                 const std::vector<std::vector<int>>& polygons, const std::string& what = "") {
+  ASSERT_EQ(soup.points.size(), points) << what;
+  EXPECT_EQ(soup.points[at], point) << what;
+  EXPECT_EQ(soup.polygons, polygons) << what;
+}
+
 // Expects reading path to throw an InputError naming the file and containing `expected`.
 void expect_input_error(const std::string& path, const std::string& expected) {
   try {
@@ -201,10 +209,7 @@ TEST(PlyRead, AsciiWithColoursAndExtraProperties) {
                                "3 0 1 2 255 255 255\n"
                                "4 0 1 3 2 0 0 0\n"
                                "0 1\n");
-  const PolygonSoup soup = read_polygon_soup(path);
-  ASSERT_EQ(soup.points.size(), 4u);
-  EXPECT_EQ(soup.points[3], Eigen::Vector3d(1.5, 1, -0.25));
-  EXPECT_EQ(soup.polygons, (std::vector<std::vector<int>>{{0, 1, 2}, {0, 1, 3, 2}}));
+  expect_soup(read_polygon_soup(path), 4, 3, Eigen::Vector3d(1.5, 1, -0.25), {{0, 1, 2}, {0, 1, 3, 2}});
 }
 
 // Appends value's bytes, most significant first.
@@ -224,10 +229,8 @@ TEST(PlyRead, BinaryBigEndianWithVertexIndex) {
   for (float value : {1.5f, -2.0f, 3.25f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f}) append_big_endian(contents, value);
   contents += static_cast<char>(3);
   for (std::uint32_t index : {2u, 0u, 1u}) append_big_endian(contents, index);
-  const PolygonSoup soup = read_polygon_soup(test::write_file(test::temp_dir("ply") + "/big.ply", contents));
-  ASSERT_EQ(soup.points.size(), 3u);
-  EXPECT_EQ(soup.points[0], Eigen::Vector3d(1.5, -2.0, 3.25));
-  EXPECT_EQ(soup.polygons, (std::vector<std::vector<int>>{{2, 0, 1}}));
+  expect_soup(read_polygon_soup(test::write_file(test::temp_dir("ply") + "/big.ply", contents)), 3, 0, Eigen::Vector3d(1.5, -2.0, 3.25),
+              {{2, 0, 1}});
 }
 
 // A binary STL of the given triangles (9 floats each), with the given text at the start of its
@@ -400,10 +403,7 @@ TEST(PlyRead, UndefinedHeaderLinesAreFreeText) {
                                             "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                                             "element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
                                             "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-  const PolygonSoup soup = read_polygon_soup(path);
-  ASSERT_EQ(soup.points.size(), 3u);
-  EXPECT_EQ(soup.points[1], Eigen::Vector3d(1, 0, 0));
-  EXPECT_EQ(soup.polygons, (std::vector<std::vector<int>>{{0, 1, 2}}));
+  expect_soup(read_polygon_soup(path), 3, 1, Eigen::Vector3d(1, 0, 0), {{0, 1, 2}});
 }
 
 // A UTF-8 byte-order mark before a text format is dropped (Windows editors write one); UTF-16
@@ -416,10 +416,7 @@ TEST(TextRead, ByteOrderMarks) {
   const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   for (const auto& [name, text] : {std::pair<std::string, std::string>{"a.off", off}, {"a.obj", obj}, {"a.ply", ply}}) {
-    const PolygonSoup soup = read_polygon_soup(test::write_file(dir + "/" + name, bom + text));
-    ASSERT_EQ(soup.points.size(), 3u) << name;
-    EXPECT_EQ(soup.points[2], Eigen::Vector3d(0, 1, 0)) << name;
-    EXPECT_EQ(soup.polygons, (std::vector<std::vector<int>>{{0, 1, 2}})) << name;
+    expect_soup(read_polygon_soup(test::write_file(dir + "/" + name, bom + text)), 3, 2, Eigen::Vector3d(0, 1, 0), {{0, 1, 2}}, name);
   }
   // "OFF\n" in UTF-16, little- and big-endian.
   expect_input_error(test::write_file(dir + "/le.off", std::string("\xFF\xFEO\0F\0F\0\n\0", 10)), "UTF-16 text (byte-order mark FF FE)");
