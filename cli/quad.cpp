@@ -266,14 +266,16 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // rod's sides): the splits keep their shape, and on such rods the split model's tries flipped
   // quads and missed by up to 0.98 %, 107–155 s each, where the model as read gave valid quads in
   // 4–31 s (bench/quad.md, thirty-first session). No benchmarked mesh has over 6 % of its area so.
-  const bool may_split = options.map_dir.empty() && options.split_edges > 0;
-  const double sliver_share = may_split ? sliver_area_share(prepared.mesh, kSliverAspect) : 0;
-  if (sliver_share > kSliverShareNoSplit)
+  // (Measured with --map too: its quads' warning says what the split would have done.)
+  const auto split_length = [&](const TriMesh& mesh) { return options.split_edges * split_cell(mesh); };
+  const double sliver_share = options.split_edges > 0 ? sliver_area_share(prepared.mesh, kSliverAspect) : 0;
+  const bool splittable = options.split_edges > 0 && sliver_share <= kSliverShareNoSplit;
+  if (options.map_dir.empty() && sliver_share > kSliverShareNoSplit)
     progress.stage("split", "not split: " + std::to_string(static_cast<int>(std::lround(100 * sliver_share))) +
                                 " % of the area is in sliver triangles, which splitting keeps");
   SplitLongEdges split;
-  if (may_split && sliver_share <= kSliverShareNoSplit) {
-    split = split_long_edges(prepared.mesh, options.split_edges * split_cell(prepared.mesh), kSplitEdgesMaxFaces);
+  if (options.map_dir.empty() && splittable) {
+    split = split_long_edges(prepared.mesh, split_length(prepared.mesh), kSplitEdgesMaxFaces);
     if (split.rounds > 0)
       progress.stage("split", std::to_string(split.rounds) + " rounds of long edges split: " + std::to_string(split.mesh.num_faces()) +
                                   " triangles" + (split.capped ? " (capped)" : ""));
@@ -304,7 +306,7 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
       separated_as_read.separation = &*separation;
       separated_as_read.quads_on = &as_read;
       if (split.rounds > 0) {
-        separated_split = split_long_edges(separation->mesh, options.split_edges * split_cell(separation->mesh), kSplitEdgesMaxFaces);
+        separated_split = split_long_edges(separation->mesh, split_length(separation->mesh), kSplitEdgesMaxFaces);
         separated_split_copy.mesh = &separated_split.mesh;
         separated_split_copy.sampled = &separation->mesh;
         separated_split_copy.split = true;
@@ -741,9 +743,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   // not made. Said when the quads are flipped, degenerate or far, and the model has edges the
   // split would halve.
   const bool short_of_valid = q.flipped_quads > 0 || q.degenerate_quads > 0 || (q.hausdorff_measured && q.hausdorff_percent > kHausdorffWarnPercent);
-  if (!options.map_dir.empty() && short_of_valid && options.split_edges > 0 &&
-      sliver_area_share(prepared.mesh, kSliverAspect) <= kSliverShareNoSplit) {
-    const double longest = options.split_edges * split_cell(prepared.mesh);
+  if (!options.map_dir.empty() && short_of_valid && splittable) {
+    const double longest = split_length(prepared.mesh);
     const EdgeMap edges = build_edge_map(prepared.mesh.F);
     int long_edges = 0;
     for (int e = 0; e < edges.num_edges(); ++e)
