@@ -16,6 +16,10 @@ inline constexpr double kSmallestDiagonal = 1e-50, kLargestDiagonal = 1e50;
 // A boundary vertex within this times the bounding-box diagonal of the inside of another face's
 // boundary edge is a T-junction, and that face is split there (prepare_mesh).
 inline constexpr double kTJunctionTolerance = 1e-5;
+// A face whose smallest altitude is at most this fraction of the bounding-box diagonal has no
+// area the stages can use (its cotangents and flat metric are rounding noise): it counts as a
+// zero-area face, as an exactly collinear one does.
+inline constexpr double kZeroAltitude = 1e-12;
 
 struct PrepareOptions {
   // Close every boundary loop with CGAL's hole filling (triangulate and refine, no fairing).
@@ -43,7 +47,7 @@ struct MeshDiagnosis {
   int nonmanifold_edges = 0;     // edges with more than two faces
   int nonmanifold_vertices = 0;  // vertices whose faces form more than one fan
   bool orientable = true;        // false: no consistent orientation exists
-  int degenerate_faces = 0;      // zero-area faces that could not be removed
+  int degenerate_faces = 0;      // zero-area faces (collinear, or kZeroAltitude) that could not be removed
   int self_intersections = -1;   // intersecting face pairs; -1 when not checked
   int euler = 0;                 // V - E + F
   std::optional<int> genus;      // set for 2-manifold, orientable meshes

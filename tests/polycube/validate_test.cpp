@@ -8,6 +8,7 @@
 #include "support/generated_meshes.h"
 #include "support/test_support.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <map>
@@ -236,6 +237,53 @@ TEST(Validate, ZeroAreaFaceIsRemovedWhenTheMeshStaysValid) {
   EXPECT_FALSE(prepared.repairs.empty());
   EXPECT_NEAR(signed_volume(prepared.mesh), 1.0, 1e-12);
   EXPECT_NEAR(surface_area(prepared.mesh), 6.0, 1e-12);
+}
+
+// Faces that are not exactly collinear but whose smallest altitude is rounding noise (at most
+// kZeroAltitude of the diagonal) count as zero-area too: the same cube with vertex 8 a hair off
+// the edge 4-5 (a cap) or a hair from vertex 4 (a needle besides). OpenSCAD's issue945e.stl had
+// 9 such faces: they passed validation and every map through them flipped (the disk maps' own
+// triangles too). A thin face well above that altitude is kept as it is.
+TEST(Validate, FacesOfRoundingNoiseAltitudeAreZeroAreaToo) {
+  const auto cube_with_cap = [](const Eigen::Vector3d& extra) {
+    PolygonSoup soup = cube_quads();
+    soup.points.push_back(extra);
+    soup.polygons[1] = {4, 8, 7};
+    soup.polygons.push_back({8, 5, 6});
+    soup.polygons.push_back({8, 6, 7});
+    soup.polygons.push_back({4, 5, 8});
+    return soup;
+  };
+  // The smallest altitude of the mesh's faces (twice the area over the longest edge).
+  const auto smallest_altitude = [](const TriMesh& mesh) {
+    double smallest = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < mesh.num_faces(); ++f) {
+      const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      smallest = std::min(smallest, (b - a).cross(c - a).norm() / longest);
+    }
+    return smallest;
+  };
+  for (const Eigen::Vector3d& extra : {Eigen::Vector3d(0.5, 1e-14, 1), Eigen::Vector3d(1e-13, 1e-14, 1)}) {
+    const PolygonSoup soup = cube_with_cap(extra);
+    const PreparedMesh prepared = prepare_mesh(soup);
+    EXPECT_TRUE(prepared.diagnosis.valid()) << (prepared.diagnosis.problems.empty() ? "" : prepared.diagnosis.problems[0]);
+    EXPECT_EQ(prepared.diagnosis.degenerate_faces, 0);
+    ASSERT_FALSE(prepared.repairs.empty());
+    EXPECT_NE(prepared.repairs.back().find("zero-area"), std::string::npos) << prepared.repairs.back();
+    // The cap's long edge is flipped (vertex 8 stays, on the cube's edge), the needle's short
+    // edge collapsed (vertex 8 merged into 4).
+    EXPECT_EQ(prepared.mesh.num_vertices(), extra.x() == 0.5 ? 9 : 8) << extra.transpose();
+    EXPECT_GT(smallest_altitude(prepared.mesh), 0.1) << extra.transpose();
+    EXPECT_EQ(prepared.diagnosis.genus, 0);
+    EXPECT_NEAR(signed_volume(prepared.mesh), 1.0, 1e-12);
+    EXPECT_NEAR(surface_area(prepared.mesh), 6.0, 1e-12);
+  }
+  const PreparedMesh thin = prepare_mesh(cube_with_cap(Eigen::Vector3d(0.5, 1e-9, 1)));
+  EXPECT_TRUE(thin.diagnosis.valid());
+  EXPECT_EQ(thin.mesh.num_vertices(), 9);
+  EXPECT_LT(smallest_altitude(thin.mesh), 1e-8);
+  for (const std::string& repair : thin.repairs) EXPECT_EQ(repair.find("zero-area"), std::string::npos) << repair;
 }
 
 TEST(Validate, NonFiniteCoordinatesAndBadIndicesThrowInputError) {
