@@ -298,10 +298,19 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   std::optional<Separation> separation;
   SplitLongEdges separated_split;
   QuadModel separated_as_read, separated_split_copy;
+  bool separation_failed = false;  // the smoothing left crossings: no copy (a warning said so)
   const auto separated_of = [&](const QuadModel& on) -> const QuadModel* {
-    if (prepared.diagnosis.self_intersections <= 0 || on.separation || options.separate == "never") return nullptr;
+    if (prepared.diagnosis.self_intersections <= 0 || on.separation || options.separate == "never" || separation_failed)
+      return nullptr;
     if (!separated_as_read.mesh) {
-      separation = separated_for_stages(prepared, progress, report);
+      try {
+        separation = separated_for_stages(prepared, progress, report);
+      } catch (const AlgorithmError& e) {
+        progress.warning(std::string(e.what()) + ": no separated copy, the model as read only");
+        report["separation"] = {{"failed", e.what()}};
+        separation_failed = true;
+        return nullptr;
+      }
       separated_as_read.mesh = &separation->mesh;
       separated_as_read.separation = &*separation;
       separated_as_read.quads_on = &as_read;
