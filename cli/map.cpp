@@ -564,20 +564,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   std::vector<std::string> outputs;
   // Self-intersecting: every stage runs on the separated copy; P's images on it go back to the
   // model at the end, where the files are audited (below).
-  // When the smoothing cannot pull the crossings apart, the stages run on the model as read (as
-  // with --separate never), with a warning: the map is intrinsic, and the audit judges the files
-  // on the model either way (OpenSCAD's adns2610_dev_circuit_inv.stl: 26 crossing pairs, 82 after
-  // 20 rounds; this used to end with exit 6).
-  const std::optional<Separation> separation = [&]() -> std::optional<Separation> {
-    if (options.separate != "always") return std::nullopt;
-    try {
-      return separated_for_stages(prepared, progress, report);
-    } catch (const AlgorithmError& e) {
-      progress.warning(std::string(e.what()) + ": the stages run on the model as read");
-      report["separation"] = {{"failed", e.what()}};
-      return std::nullopt;
-    }
-  }();
+  // When the smoothing cannot pull the crossings apart, none: the stages run on the model as read
+  // (as with --separate never; the map is intrinsic, and the audit judges the files on the model
+  // either way. OpenSCAD's adns2610_dev_circuit_inv.stl: 26 crossing pairs, 82 after 20 rounds).
+  const std::optional<Separation> separation =
+      options.separate == "always" ? separated_for_stages(prepared, progress, report) : std::nullopt;
   const TriMesh& source = separation ? separation->mesh : prepared.mesh;
 
   // The pipeline runs on the model turned into the chosen frame; outputs go back to the input's.

@@ -1,6 +1,7 @@
 #include "cli/mesh_input.h"
 
 #include "formats/mesh_io.h"
+#include "polycube/errors.h"
 
 #include <iomanip>
 #include <sstream>
@@ -30,7 +31,14 @@ PreparedMesh load_mesh(const MeshInput& input, const Progress& progress) {
 std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report) {
   if (prepared.diagnosis.self_intersections <= 0) return std::nullopt;
   progress.stage("separate", "the model intersects itself: smoothing round the crossings, on a copy the planes cut");
-  Separation s = separate_self_intersections(prepared.mesh);
+  Separation s;
+  try {
+    s = separate_self_intersections(prepared.mesh);
+  } catch (const AlgorithmError& e) {
+    progress.warning(std::string(e.what()) + ": no separated copy; the model as read is used");
+    report["separation"] = {{"failed", e.what()}};
+    return std::nullopt;
+  }
   progress.stage("separate", std::to_string(s.pairs_before) + " face pairs apart after " + std::to_string(s.rounds) + " rounds; " +
                                  std::to_string(s.moved_vertices) + " vertices moved, by up to " +
                                  std::to_string(100 * s.max_shift) + " % of the diagonal");

@@ -26,7 +26,10 @@ PreparedMesh load_mesh(const MeshInput& input, const Progress& progress);
 
 // When the model intersects itself: its separated copy (separate.h; same vertices and faces) for
 // the stages that cut it by planes, said on stderr and in `report` ("separation"); nothing
-// otherwise. Results on the copy go back to the model with to_original_surface.
+// otherwise, and nothing when the smoothing leaves crossings after its rounds (a warning, and
+// `separation.failed` in `report`: the caller works on the model as read; before the thirty-ninth
+// session that ended the command with exit 6). Results on the copy go back to the model with
+// to_original_surface.
 std::optional<Separation> separated_for_stages(const PreparedMesh& prepared, const Progress& progress, nlohmann::json& report);
 
 // A long model's scaled copy (equalised_copy), said on stderr and in `report` (its deviations and

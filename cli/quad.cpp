@@ -303,11 +303,8 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     if (prepared.diagnosis.self_intersections <= 0 || on.separation || options.separate == "never" || separation_failed)
       return nullptr;
     if (!separated_as_read.mesh) {
-      try {
-        separation = separated_for_stages(prepared, progress, report);
-      } catch (const AlgorithmError& e) {
-        progress.warning(std::string(e.what()) + ": no separated copy, the model as read only");
-        report["separation"] = {{"failed", e.what()}};
+      separation = separated_for_stages(prepared, progress, report);
+      if (!separation) {
         separation_failed = true;
         return nullptr;
       }

@@ -554,8 +554,8 @@ PreparedMesh prepare_mesh(const PolygonSoup& soup, const PrepareOptions& options
     }
   }
 
-  if (const int zero_area = count_zero_area_faces(mesh, zero_altitude(mesh)); zero_area > 0) {
-    if (repairable && remove_degenerate_faces(mesh, zero_altitude(mesh)))
+  if (const double min_altitude = zero_altitude(mesh); const int zero_area = count_zero_area_faces(mesh, min_altitude)) {
+    if (repairable && remove_degenerate_faces(mesh, min_altitude))
       result.repairs.push_back("removed " + plural(zero_area, "zero-area face") + " by edge collapses and flips");
   }
 

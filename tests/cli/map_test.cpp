@@ -238,7 +238,7 @@ TEST(MapCli, AModelTheSeparationCannotPullApartIsMappedAsRead) {
   const std::string dir = test::temp_dir("map-unseparated");
   const CliRun run = polycube_cli("map --stage polycube " + quoted(test::data_path("adns2610_dev_circuit_inv.stl")) + " -o " + quoted(dir));
   ASSERT_EQ(run.code, 0) << run.err;
-  EXPECT_NE(run.err.find("still intersect after 20 rounds of local smoothing: the stages run on the model as read"), std::string::npos)
+  EXPECT_NE(run.err.find("still intersect after 20 rounds of local smoothing: no separated copy; the model as read is used"), std::string::npos)
       << run.err;
   const auto report = read_json(dir + "/report.json");
   ASSERT_TRUE(report.contains("separation"));
