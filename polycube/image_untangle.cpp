@@ -33,7 +33,8 @@ class Untangler {
   Untangler(const TriMesh& source, const Eigen::MatrixX3d& image, const TriMesh& target, const ImageUntangleOptions& options)
       : source_(source), surface_(target, "untangle_image"), input_(image), image_(image), face_(source.num_vertices()),
         star_(source.num_vertices()), bad_(source.num_faces()), room_(source.num_vertices()), shortest_(source.num_vertices()),
-        edge_share_(options.max_edge_share) {
+        edge_share_(options.max_edge_share), stamp_(source.num_vertices(), 0), no_move_stamp_(source.num_vertices(), -1),
+        no_move_bound_(source.num_vertices(), 0.0), no_fan_move_stamp_(source.num_vertices(), -1) {
     for (int v = 0; v < source.num_vertices(); ++v) face_[v] = surface_.closest(point(v)).first;
     for (int f = 0; f < source.num_faces(); ++f) {
       for (int c = 0; c < 3; ++c) star_[source.F(f, c)].push_back(f);
@@ -52,6 +53,8 @@ class Untangler {
     face_ = input_face_;
     bad_ = input_bad_;
     set_room(max_shift);
+    std::fill(no_move_stamp_.begin(), no_move_stamp_.end(), -1);
+    std::fill(no_fan_move_stamp_.begin(), no_fan_move_stamp_.end(), -1);
   }
 
   int bad_count() const { return static_cast<int>(std::count(bad_.begin(), bad_.end(), true)); }
@@ -161,7 +164,15 @@ class Untangler {
   // A move of v that raises the smallest signed area of its fan (in the tangent plane of its
   // closest face) without raising the bad triangles round it or turning a good one bad: towards
   // the widest-fan point within its shortest image edge, the whole, half or a quarter of the way.
+  // A search that found none is not repeated while v's ring is unchanged.
   std::optional<Move> fan_move(int v) {
+    if (no_fan_move_stamp_[v] == stamp_[v]) return std::nullopt;
+    std::optional<Move> move = search_fan_move(v);
+    if (!move) no_fan_move_stamp_[v] = stamp_[v];
+    return move;
+  }
+
+  std::optional<Move> search_fan_move(int v) {
     const std::vector<int>& star = star_[v];
     const double shortest = shortest_edge(v);
     if (!std::isfinite(shortest)) return std::nullopt;
@@ -184,7 +195,7 @@ class Untangler {
       // The gain must be real: a relative margin keeps the sweeps from creeping.
       if (!(smallest_fan_area(v, q, frame.normal) > now + 1e-9 * shortest * shortest)) continue;
       const int face = surface_.closest(q).first;
-      if (const std::optional<int> bad_after = trial(v, q, face, before); bad_after && *bad_after <= bad_before)
+      if (trial(v, q, face, before, bad_before + 1))
         return Move{v, q, face, (q - old).norm()};
     }
     return std::nullopt;
@@ -222,26 +233,26 @@ class Untangler {
     return count;
   }
 
-  // The bad triangles of v's fan with v's image at q (closest face `face`), or nothing if a
-  // triangle good `before` turns bad; v's image is left where it was.
-  std::optional<int> trial(int v, const Eigen::Vector3d& q, int face, const std::vector<bool>& before) {
+  // Whether v's image at q (closest face `face`) turns no triangle of its fan that was good
+  // `before` bad and leaves fewer than `limit` bad ones; v's image is left where it was. The good
+  // ones are judged first and the judging stops at the first verdict against: a triangle that
+  // stays bad costs the audit's finer look (13 more closest points), so a move refused by a good
+  // one is refused before them.
+  bool trial(int v, const Eigen::Vector3d& q, int face, const std::vector<bool>& before, int limit) {
     const Eigen::Vector3d old = point(v);
     const int old_face = face_[v];
     image_.row(v) = q.transpose();
     face_[v] = face;
     const std::vector<int>& star = star_[v];
-    std::optional<int> bad_after = 0;
-    for (size_t k = 0; k < star.size(); ++k) {
-      const bool bad = judge(star[k]);
-      if (bad && !before[k]) {
-        bad_after.reset();
-        break;
-      }
-      *bad_after += bad;
-    }
+    bool accepted = true;
+    for (size_t k = 0; k < star.size() && accepted; ++k)
+      if (!before[k] && judge(star[k])) accepted = false;
+    int bad = 0;
+    for (size_t k = 0; k < star.size() && accepted; ++k)
+      if (before[k] && judge(star[k]) && ++bad >= limit) accepted = false;
     image_.row(v) = old.transpose();
     face_[v] = old_face;
-    return bad_after;
+    return accepted;
   }
 
   bool judge(int f) const {
@@ -249,14 +260,26 @@ class Untangler {
     return surface_.judge(point(a), point(b), point(c), face_[a], face_[b], face_[c]) != 0;
   }
 
+  // v's image moved to p: its fan judged again, and v's and its neighbours' stamps raised.
   void place(int v, const Eigen::Vector3d& p, int face) {
     image_.row(v) = p.transpose();
     face_[v] = face;
-    for (int f : star_[v]) bad_[f] = judge(f);
+    for (int f : star_[v]) {
+      bad_[f] = judge(f);
+      for (int c = 0; c < 3; ++c) ++stamp_[source_.F(f, c)];
+    }
   }
 
-  // The acceptable point round v's image closest to it (not farther than `bound`), if any.
+  // The acceptable point round v's image closest to it (not farther than `bound`), if any. A
+  // search that found none is not repeated while v's ring is unchanged and the bound no larger.
   std::optional<Move> best_move(int v, double bound) {
+    if (no_move_stamp_[v] == stamp_[v] && bound <= no_move_bound_[v]) return std::nullopt;
+    std::optional<Move> move = search_move(v, bound);
+    if (!move) no_move_stamp_[v] = stamp_[v], no_move_bound_[v] = bound;
+    return move;
+  }
+
+  std::optional<Move> search_move(int v, double bound) {
     std::vector<bool> before;
     const int bad_before = star_bad(v, before);
     if (bad_before == 0) return std::nullopt;
@@ -275,7 +298,7 @@ class Untangler {
         if ((q - origin).norm() > room_[v] || shift == 0 || (best && shift >= best->shift) || shift >= bound) continue;
         // The face the audit finds for q (on an edge, the projection's face may be the other one).
         const int face = surface_.closest(q).first;
-        if (const std::optional<int> bad_after = trial(v, q, face, before); bad_after && *bad_after < bad_before)
+        if (trial(v, q, face, before, bad_before))
           best = Move{v, q, face, shift};
       }
     }
@@ -294,6 +317,15 @@ class Untangler {
   std::vector<int> input_face_;         // face_ and bad_ for the input images
   std::vector<bool> input_bad_;
   double edge_share_;
+  // A move's search depends on v's ring only: the images and closest faces of v and its
+  // neighbours, the bad flags of its fan (functions of those) and v's fixed input and room. Each
+  // vertex's stamp rises whenever it or a neighbour moves (place); a search that found no move
+  // records the stamp it saw (and best_move its bound), and is skipped while that still holds.
+  // restart() clears the records (the room changes). The same moves as searching every time.
+  std::vector<long> stamp_;
+  std::vector<long> no_move_stamp_;
+  std::vector<double> no_move_bound_;
+  std::vector<long> no_fan_move_stamp_;
 };
 
 }  // namespace
