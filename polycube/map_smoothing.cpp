@@ -161,13 +161,15 @@ class Chart {
   explicit Chart(const Surface& surface)
       : S_(surface), vertex_stamp_(surface.mesh().num_vertices(), 0), radius_(surface.mesh().num_vertices()),
         angle_(surface.mesh().num_vertices()), position_(surface.mesh().num_vertices()), face_stamp_(surface.mesh().num_faces(), 0),
-        depth_(surface.mesh().num_faces(), 0) {}
+        depth_(surface.mesh().num_faces(), 0), sheet_stamp_(surface.mesh().num_vertices(), 0), sheet_turns_(surface.mesh().num_vertices()),
+        sheet_position_(surface.mesh().num_vertices()) {}
 
   // Lays out the triangles within `depth` steps across edges of the centre's star.
   void build(int centre, int depth) {
     if (++stamp_ == 0) {
       std::fill(vertex_stamp_.begin(), vertex_stamp_.end(), 0);
       std::fill(face_stamp_.begin(), face_stamp_.end(), 0);
+      std::fill(sheet_stamp_.begin(), sheet_stamp_.end(), 0);
       stamp_ = 1;
     }
     centre_ = centre;
@@ -203,6 +205,7 @@ class Chart {
 
   void set(int v, double r, double theta) {
     vertex_stamp_[v] = stamp_;
+    sheet_stamp_[v] = 0;
     radius_[v] = r;
     angle_[v] = theta;
     position_[v] = chart_position(r, theta);
@@ -224,14 +227,20 @@ class Chart {
     triangles_.push_back(f);
   }
 
-  Vec2 sheet_position(int v, double reference) const {
+  // v's unscaled position in the sheet of angle `reference`; the last one asked of each vertex is
+  // kept (every unfolding asks for its edge's two ends, and grow() unfolds each triangle twice).
+  Vec2 sheet_position(int v, double reference) {
     if (radius_[v] == 0) return Vec2::Zero();
-    const double theta = angle_[v] + cone_angle_ * std::round((reference - angle_[v]) / cone_angle_);
-    return Vec2(radius_[v] * std::cos(theta), radius_[v] * std::sin(theta));
+    const double turns = std::round((reference - angle_[v]) / cone_angle_);
+    if (sheet_stamp_[v] == stamp_ && sheet_turns_[v] == turns) return sheet_position_[v];
+    const double theta = angle_[v] + cone_angle_ * turns;
+    sheet_stamp_[v] = stamp_;
+    sheet_turns_[v] = turns;
+    return sheet_position_[v] = Vec2(radius_[v] * std::cos(theta), radius_[v] * std::sin(theta));
   }
 
   // g unfolded across its edge shared with the placed triangle f.
-  Unfolding unfolding(int f, int g) const {
+  Unfolding unfolding(int f, int g) {
     const TriMesh& m = S_.mesh();
     Unfolding u;
     int ic = 0;
@@ -304,6 +313,9 @@ class Chart {
   std::vector<Vec2> position_;
   std::vector<int> face_stamp_, depth_;
   std::vector<int> triangles_;
+  std::vector<int> sheet_stamp_;  // sheet_position's last answer per vertex, valid at stamp_
+  std::vector<double> sheet_turns_;
+  std::vector<Vec2> sheet_position_;
   int centre_ = -1;
   double cone_angle_ = kTwoPi;
   double unit_ = 1;
