@@ -98,6 +98,7 @@ class Surface {
   // Per-thread work space of project (and of the moves that call it).
   struct Scratch {
     std::vector<int> stamp, queue;
+    std::vector<TriangleClosest> closest;  // t's closest point on each queued face
     int current = 0;
     std::vector<char> good;
   };
@@ -116,13 +117,15 @@ class Surface {
       std::fill(stamp.begin(), stamp.end(), 0);
       current = 1;
     }
+    std::vector<TriangleClosest>& closest = scratch.closest;
     queue.assign(1, from.face);
+    closest.assign(1, closest_on_triangle(t, corner(from.face, 0), corner(from.face, 1), corner(from.face, 2)));
     stamp[from.face] = current;
     SurfacePoint best = from;
     double best_d2 = d0;
     for (size_t k = 0; k < queue.size() && k < kMaxVisited; ++k) {
       const int f = queue[k];
-      const Closest c = closest_on_triangle(t, corner(f, 0), corner(f, 1), corner(f, 2));
+      const Closest c = closest[k];  // (a copy: the loop below appends)
       const double d2 = (c.point - t).squaredNorm();
       if (d2 < best_d2) {
         best_d2 = d2;
@@ -133,7 +136,11 @@ class Surface {
         const int g = across_(f, i);
         if (stamp[g] == current) continue;
         stamp[g] = current;
-        if ((closest_on_triangle(t, corner(g, 0), corner(g, 1), corner(g, 2)).point - t).squaredNorm() <= radius2) queue.push_back(g);
+        const Closest cg = closest_on_triangle(t, corner(g, 0), corner(g, 1), corner(g, 2));
+        if ((cg.point - t).squaredNorm() <= radius2) {
+          queue.push_back(g);
+          closest.push_back(cg);
+        }
       }
     }
     return best;
