@@ -350,10 +350,12 @@ ImageUntangleResult untangle_image(const TriMesh& source, const Eigen::MatrixX3d
   result.image = untangler.image();
   result.bad_after = untangler.bad_count();
   result.shift_allowed = options.max_shift;
+  if (options.after_run && result.bad_before > 0) options.after_run(options.max_shift, result.bad_after);
   for (const double shift : options.wider_shifts) {
     if (result.bad_after == 0) break;
     untangler.restart(shift);
     run();
+    if (options.after_run) options.after_run(shift, untangler.bad_count());
     if (!(untangler.bad_count() < result.bad_after)) break;  // more room brought nothing: stop
     result.image = untangler.image();
     result.bad_after = untangler.bad_count();

@@ -37,6 +37,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <vector>
 
 namespace polycube {
@@ -58,6 +59,10 @@ struct ImageUntangleOptions {
   // its 11 finished maps — and a run that brings nothing ends the search.) The set-up (closest
   // faces, the audit's verdicts on the input) is made once for all runs.
   std::vector<double> wider_shifts;
+  // Called after each run with its shift (max_shift, then the wider ones tried) and the bad
+  // triangles it left: progress for the caller (a run on a large map of a CAD model that passes
+  // through itself can take minutes). Not called when nothing is bad to begin with.
+  std::function<void(double shift, int bad_left)> after_run;
 };
 
 // The corrected images and what it took.

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace polycube {
 namespace {
@@ -122,7 +124,11 @@ TEST(ImageUntangle, AWiderShiftRunsAgainFromTheInput) {
 
   ImageUntangleOptions wider = narrow;
   wider.wider_shifts = {0.05, 0.1, 0.2};
+  std::vector<std::pair<double, int>> runs;  // after_run's reports, one per run made
+  wider.after_run = [&runs](double shift, int bad_left) { runs.emplace_back(shift, bad_left); };
   const ImageUntangleResult result = untangle_image(grid, image, grid, wider);
+  const std::vector<std::pair<double, int>> expected_runs = {{0.02, stuck.bad_after}, {0.05, middle_left}, {0.1, 0}};
+  EXPECT_EQ(runs, expected_runs);
   EXPECT_EQ(result.bad_before, stuck.bad_before);
   EXPECT_EQ(result.bad_after, 0);
   EXPECT_EQ(result.shift_allowed, 0.1);  // the first that leaves none; 0.2 is not run
