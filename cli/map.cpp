@@ -300,7 +300,7 @@ void untangle_images(const TriMesh& model, Finished& out, double max_shift, doub
   // Each run's outcome as it ends (a run can take minutes on a large map of a CAD model that
   // passes through itself: OpenSCAD's bad-stl-wing.stl, 2 580 bad triangles, 10 minutes).
   auto run = [&options, &progress](const TriMesh& source, Eigen::MatrixX3d& image, const TriMesh& target, const std::string& direction) {
-    options.after_run = [&](double shift, int bad_left) {
+    options.after_run = [&progress, direction](double shift, int bad_left) {
       std::ostringstream line;
       line << direction << ", room " << 100 * shift << " % of the diagonal: " << bad_left << " left";
       progress.stage("untangle", line.str());

@@ -93,8 +93,12 @@ TEST(ImageUntangle, UnfoldsAReversedSliverByASmallMove) {
 TEST(ImageUntangle, MovesNothingWithoutRoomOrFolds) {
   const int n = 6;
   const TriMesh grid = flat_grid(n);
-  // No fold: the input is returned.
-  const ImageUntangleResult clean = untangle_image(grid, grid.V, grid);
+  // No fold: the input is returned, and no run is reported.
+  ImageUntangleOptions counted;
+  int reports = 0;
+  counted.after_run = [&reports](double, int) { ++reports; };
+  const ImageUntangleResult clean = untangle_image(grid, grid.V, grid, counted);
+  EXPECT_EQ(reports, 0);
   EXPECT_EQ(clean.bad_before, 0);
   EXPECT_EQ(clean.moved, 0);
   EXPECT_EQ(clean.image, grid.V);
