@@ -282,13 +282,21 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   const bool distinct_normals =
       !options.input_frame_only && !same_axes(normals, Eigen::Matrix3d::Identity()) && !same_axes(normals, pca);
   const bool reserve_normals = distinct_normals && !(misalignment < options.normal_axes_misalignment);
+  // A frame's candidates, less any whose rotation is exactly one already there: principal axes
+  // snapped to the coordinate axes can be a cyclic permutation of them, and then a candidate is
+  // an earlier one again, with the same stages and map, filling one of the few mapped and
+  // alternative places (Cura's printer plate twotrees235x235_generic.stl: four of its ten
+  // candidates, and two of the map's retries, repeated the input frame's). Turned by 180° about
+  // an axis (other signs) is another sampling of the same orientation, not the same stages: kept.
   auto add_frame = [&](int frame) {
     for (int k = 0; k < 3; ++k) {
       AlignmentCandidate c;
       c.name = frame == 0 ? (options.input_frame_is_principal ? principal_names[k] : input_names[k])
                           : frame == 1 ? principal_names[k] : normal_names[k];
       c.rotation = cycles[k] * (frame == 0 ? Eigen::Matrix3d::Identity() : frame == 1 ? pca : normals);
-      out.candidates.push_back(c);
+      const bool repeated = std::any_of(out.candidates.begin(), out.candidates.end(),
+                                        [&](const AlignmentCandidate& earlier) { return earlier.rotation == c.rotation; });
+      if (!repeated) out.candidates.push_back(c);
     }
   };
   add_frame(0);

@@ -3,10 +3,11 @@
 // only when no other candidate passes four times the scoring budget) and the frame its surface normals
 // align with best (normal_axes; when they align markedly, as a CAD part's do; otherwise only when
 // no other candidate passes the scoring budget; never when it is one of the other two), each with
-// each of its
-// three axes as the sweep direction z. Each gets its polycube (under a small repair budget); the
-// few with the fewest corners also get their map, and the map with the fewest flipped image
-// triangles (then the least ε_angle, then the fewest corners) wins. When no candidate passes the
+// each of its three axes as the sweep direction z (a rotation already a candidate is not one
+// again: principal axes snapped to the coordinate axes can repeat the input frame's). Each gets
+// its polycube (under a small repair budget); the few with the fewest corners also get their
+// map, and the map with the fewest flipped image triangles (then the least ε_angle, then the
+// fewest corners) wins. When no candidate passes the
 // budget, they are tried again with four times the budget, then in order with the caller's full
 // budget, and the first that builds wins (an invalid polycube is never returned: build_polycube
 // throws instead).

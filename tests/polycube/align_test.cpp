@@ -81,6 +81,29 @@ TEST(Align, AlignedModelsAreNotTilted) {
   EXPECT_GT((principal_axes(rotated(box(Eigen::Vector3d::Zero()), large)).cwiseAbs() - Eigen::Matrix3d::Identity()).norm(), 0.1);
 }
 
+// A rotation is a candidate once. The principal axes of an axis-aligned box, snapped, are signed
+// coordinate axes; where they are the input axes or a cyclic permutation of them (all signs
+// positive), each principal candidate is an input-frame candidate again (the same stages and
+// map) and is left out; turned by 180 degrees (other signs) they stay.
+TEST(Align, ARotationIsACandidateOnce) {
+  AlignmentOptions options;
+  options.mapped_candidates = 0;
+  int repeating = 0;
+  for (int shift = 0; shift < 3; ++shift) {
+    TriMesh m = box(Eigen::Vector3d(1, 2, 3));
+    for (int c = 0; c < 3; ++c) m.V.col(c) = box(Eigen::Vector3d(1, 2, 3)).V.col((c + shift) % 3);  // the long side along another axis
+    const Eigen::Matrix3d pca = principal_axes(m);
+    ASSERT_EQ((pca.cwiseAbs() * Eigen::Vector3d::Ones() - Eigen::Vector3d::Ones()).norm(), 0.0) << "snapped to the axes";
+    const bool cyclic = pca.minCoeff() >= 0;
+    repeating += cyclic;
+    const Alignment a = choose_alignment(m, TopologyOptions{}, PolycubeOptions{}, options);
+    EXPECT_EQ(a.candidates.size(), cyclic ? 3u : 6u) << "shift " << shift;
+    for (size_t i = 0; i < a.candidates.size(); ++i)
+      for (size_t j = 0; j < i; ++j) EXPECT_FALSE(a.candidates[i].rotation == a.candidates[j].rotation) << a.candidates[i].name;
+  }
+  EXPECT_GT(repeating, 0) << "no placement of the box repeats the input frame: the test tests nothing";
+}
+
 // A box turned anyhow: its faces' normals give back its frame (up to the cube's rotations), even
 // for a box whose proportions make the principal axes useless (a cube: any frame is principal).
 TEST(Align, NormalAxesOfATurnedBoxAreItsFaces) {
@@ -136,8 +159,20 @@ TEST(Align, PrincipalAxesOfACubeAreHeldInReserve) {
   ASSERT_EQ(a.candidates.size(), 3u);
   for (const AlignmentCandidate& c : a.candidates) EXPECT_EQ(c.name.rfind("input frame", 0), 0u) << c.name;
   EXPECT_GE(a.chosen, 0);
+  // Nearly a cube (spread 1.16, below the ratio): held in reserve too, and a candidate when the
+  // ratio asked is 1. (Its principal axes, z then y then x, are no turn of the input frame's:
+  // a cube's own may be, and then they are not candidates again: ARotationIsACandidateOnce.)
+  TriMesh near_cube = cube;
+  near_cube.V.col(1) *= 1.05;
+  near_cube.V.col(2) *= 1.1;
+  principal_axes(near_cube, &spread);
+  EXPECT_GT(spread, 1.1);
+  EXPECT_LT(spread, AlignmentOptions{}.principal_axes_spread);
+  EXPECT_EQ(choose_alignment(near_cube, TopologyOptions{}, PolycubeOptions{}, options).candidates.size(), 3u);
   options.principal_axes_spread = 1;
-  EXPECT_EQ(choose_alignment(cube, TopologyOptions{}, PolycubeOptions{}, options).candidates.size(), 6u);
+  const Alignment b = choose_alignment(near_cube, TopologyOptions{}, PolycubeOptions{}, options);
+  ASSERT_EQ(b.candidates.size(), 6u);
+  EXPECT_EQ(b.candidates[3].name.rfind("principal axes", 0), 0u) << b.candidates[3].name;
 }
 
 // The caller's stop ends the search: once it says so no candidate's step starts, and nothing is
