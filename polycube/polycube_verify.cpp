@@ -30,6 +30,15 @@ int contour_at(const std::vector<SectionPolygon>& polygons, const Eigen::Vector2
   return -1;
 }
 
+// What identifies a piece across M and P: its slab and the contours of its loops. The contours
+// alone do not: with a single plane (a thin plate sliced through its thickness once) the piece
+// below and the piece above both have every contour of that plane.
+std::vector<int> piece_key(int plane_below, std::vector<int> contours) {
+  std::sort(contours.begin(), contours.end());
+  contours.insert(contours.begin(), plane_below);
+  return contours;
+}
+
 }  // namespace
 
 PolycubeVerification verify_polycube(const Polycube& polycube, const CrossSections& model_sections,
@@ -110,9 +119,7 @@ PolycubeVerification verify_polycube(const Polycube& polycube, const CrossSectio
       (plane == piece.plane_above ? below : above)[c]++;
       result.piece_contours[p].push_back(c);
     }
-    std::vector<int> key = result.piece_contours[p];
-    std::sort(key.begin(), key.end());
-    polycube_piece_of[key] = static_cast<int>(p);
+    polycube_piece_of[piece_key(piece.plane_below, result.piece_contours[p])] = static_cast<int>(p);
   }
   if (positive_genus) problem(std::to_string(positive_genus) + " polycube pieces of positive genus");
   if (unmatched_loops) problem(std::to_string(unmatched_loops) + " polycube loops on no polygon of Q");
@@ -124,9 +131,7 @@ PolycubeVerification verify_polycube(const Polycube& polycube, const CrossSectio
   int unmatched_pieces = 0;
   std::set<int> used;
   for (size_t m = 0; m < model_sliced.pieces.size(); ++m) {
-    std::vector<int> key = model_sections.piece_contours[m];
-    std::sort(key.begin(), key.end());
-    const auto it = polycube_piece_of.find(key);
+    const auto it = polycube_piece_of.find(piece_key(model_sliced.pieces[m].plane_below, model_sections.piece_contours[m]));
     if (it == polycube_piece_of.end() || !used.insert(it->second).second) {
       ++unmatched_pieces;
       continue;

@@ -215,10 +215,8 @@ TEST(Polycube, ReslicesTheTopologyStagesSurfaceWhenItWasChanged) {
   EXPECT_EQ(recovered.model_sliced.pieces.size(), direct.model_sliced.pieces.size());
 }
 
-TEST(Polycube, BoxModelGivesTheBox) {
-  // A unit cube with each side split into 6 x 6 quads: every cross-section is the whole unit
-  // square, so P is the cube itself: 8 corners, 6 faces, 12 edges.
-  const int n = 6;
+// The unit cube with each side split into n x n quads (two triangles each), outward-oriented.
+TriMesh gridded_unit_cube(int n) {
   TriMesh cube;
   std::vector<Eigen::Vector3d> points;
   std::vector<std::array<int, 3>> triangles;
@@ -250,6 +248,13 @@ TEST(Polycube, BoxModelGivesTheBox) {
   for (size_t k = 0; k < points.size(); ++k) cube.V.row(k) = points[k].transpose();
   cube.F.resize(triangles.size(), 3);
   for (size_t k = 0; k < triangles.size(); ++k) cube.F.row(k) << triangles[k][0], triangles[k][1], triangles[k][2];
+  return cube;
+}
+
+TEST(Polycube, BoxModelGivesTheBox) {
+  // A unit cube with each side split into 6 x 6 quads: every cross-section is the whole unit
+  // square, so P is the cube itself: 8 corners, 6 faces, 12 edges.
+  const TriMesh cube = gridded_unit_cube(6);
   ASSERT_GT(signed_volume(cube), 0);
 
   const TopologyResult topology = analyse_topology(cube);
@@ -260,6 +265,23 @@ TEST(Polycube, BoxModelGivesTheBox) {
   EXPECT_EQ(result.polycube.edges.size(), 12u);
   EXPECT_NEAR(signed_volume(result.polycube.mesh), 1.0, 1e-12);
   EXPECT_LT(hausdorff_distance(cube, result.polycube.mesh).hausdorff, 1e-9);
+}
+
+// A thin plate swept through its thickness is sliced by a single plane: the piece below and the
+// piece above then have the same loops (every contour of that plane) and are told apart by
+// their slab (a Cura printer plate, 230 x 230 x 3, failed the final check here).
+TEST(Polycube, APlateSlicedOnceGivesTheSlab) {
+  TriMesh plate = gridded_unit_cube(6);
+  plate.V.col(2) *= 0.02;
+  const TopologyResult topology = analyse_topology(plate);
+  ASSERT_EQ(topology.planes_z.size(), 1u) << "the plate is sliced once (else the test tests nothing)";
+  ASSERT_EQ(topology.sliced.pieces.size(), 2u);
+  const PolycubeResult result = build(plate, topology);
+  expect_valid_polycube(topology, result);
+  EXPECT_EQ(result.planes_z.size(), 1u);
+  EXPECT_EQ(result.polycube.corners.size(), 8u);
+  ASSERT_EQ(result.piece_match.size(), 2u);
+  EXPECT_NE(result.piece_match[0], result.piece_match[1]);
 }
 
 // Corners and Hausdorff distance (a fraction of the diagonal) of P for d_z and d_a; P must be valid.
