@@ -52,6 +52,12 @@ int tilted_faces(const std::string& polycube_path, const Eigen::Matrix3d& R) {
   return tilted;
 }
 
+// The files of a map directory, audited as written against the model they were made for.
+MapAudit audit_written(const TriMesh& model, const std::string& dir) {
+  return audit_map(model, test::load_mesh_file(dir + "/polycube.obj"), test::load_mesh_file(dir + "/polycube_on_model.obj").V,
+                   test::load_mesh_file(dir + "/model_on_polycube.obj").V);
+}
+
 TEST(MapCli, TopologyStageWritesReportAndPieces) {
   const std::string dir = test::temp_dir("map") + "/out";  // created by the command
   const CliRun run = polycube_cli("map " + quoted(test::data_path("eight.off")) + " -o " + quoted(dir) +
@@ -157,8 +163,7 @@ TEST(MapCli, MapStageWithAutoAlignmentWritesBothImages) {
 
   // The files, audited as written (in the input frame, the map having been built in the chosen
   // one), give the report's verdicts: an outside audit of what a user reads agrees with ours.
-  const TriMesh P = test::load_mesh_file(dir + "/polycube.obj"), M = test::load_mesh_file(test::data_path("knot.off"));
-  const MapAudit files = audit_map(M, P, test::load_mesh_file(dir + "/polycube_on_model.obj").V, test::load_mesh_file(dir + "/model_on_polycube.obj").V);
+  const MapAudit files = audit_written(test::load_mesh_file(test::data_path("knot.off")), dir);
   EXPECT_EQ(files.polycube_to_model.flipped, report.at("map").at("polycube_to_model").at("flipped").get<int>());
   EXPECT_EQ(files.model_to_polycube.flipped, report.at("map").at("model_to_polycube").at("flipped").get<int>());
   EXPECT_EQ(files.polycube_to_model.degenerate, report.at("map").at("polycube_to_model").at("degenerate").get<int>());
@@ -180,8 +185,7 @@ TEST(MapCli, ASelfIntersectingModelIsMappedThroughItsSeparatedCopy) {
   EXPECT_EQ(report.at("separation").at("pairs_before").get<int>(), pairs);
   EXPECT_GE(report.at("separation").at("rounds").get<int>(), 1);
   EXPECT_TRUE(report.at("map").at("meets_contract").get<bool>());
-  const TriMesh P = test::load_mesh_file(dir + "/polycube.obj"), M = test::load_mesh_file(test::data_path("elk.off"));
-  const MapAudit files = audit_map(M, P, test::load_mesh_file(dir + "/polycube_on_model.obj").V, test::load_mesh_file(dir + "/model_on_polycube.obj").V);
+  const MapAudit files = audit_written(test::load_mesh_file(test::data_path("elk.off")), dir);
   // P's images, moved back from the copy: on the model (the copy is up to a percent of the
   // diagonal away), none flipped or degenerate there, as the report says.
   EXPECT_EQ(files.polycube_to_model.flipped, 0);
@@ -215,9 +219,7 @@ TEST(MapCli, ASeparatedModelsMapsAreJudgedOnTheModel) {
     fill.fill_holes = true;
     return fill;
   }());
-  const TriMesh P = test::load_mesh_file(dir + "/polycube.obj");
-  const MapAudit files = audit_map(model.mesh, P, test::load_mesh_file(dir + "/polycube_on_model.obj").V,
-                                   test::load_mesh_file(dir + "/model_on_polycube.obj").V);
+  const MapAudit files = audit_written(model.mesh, dir);
   EXPECT_EQ(files.polycube_to_model.flipped + files.polycube_to_model.degenerate, 0);
   EXPECT_EQ(files.model_to_polycube.flipped + files.model_to_polycube.degenerate, 0);
   EXPECT_TRUE(files.polycube_to_model.ok) << "P's image covers " << files.polycube_to_model.area_ratio << " of the model";
@@ -630,9 +632,7 @@ TEST(MapCli, TheScaledCopysMapStandsWhenTheModelsOwnIsWorse) {
   EXPECT_NE(report.at("alignment").at("chosen").get<std::string>().find("on a copy scaled along them"), std::string::npos);
   EXPECT_TRUE(report.at("map").at("meets_contract").get<bool>());
   EXPECT_GT(report.at("map").at("eps_angle").get<double>(), 1.1);
-  const TriMesh P = test::load_mesh_file(out + "/polycube.obj");
-  const MapAudit files = audit_map(needle, P, test::load_mesh_file(out + "/polycube_on_model.obj").V,
-                                   test::load_mesh_file(out + "/model_on_polycube.obj").V);
+  const MapAudit files = audit_written(needle, out);
   EXPECT_EQ(files.polycube_to_model.flipped + files.model_to_polycube.flipped, 0);
   EXPECT_EQ(tilted_faces(out + "/polycube.obj", report_rotation(report)), 0);
 }
@@ -656,9 +656,7 @@ TEST(MapCli, AThinPlateIsSweptThroughItsThickness) {
   EXPECT_EQ(report.at("polycube").at("planes").size(), 1u);
   EXPECT_TRUE(report.at("map").at("meets_contract").get<bool>());
   EXPECT_LT(report.at("map").at("eps_angle").get<double>(), 1.01);
-  const TriMesh P = test::load_mesh_file(out + "/polycube.obj");
-  const MapAudit files = audit_map(plate, P, test::load_mesh_file(out + "/polycube_on_model.obj").V,
-                                   test::load_mesh_file(out + "/model_on_polycube.obj").V);
+  const MapAudit files = audit_written(plate, out);
   EXPECT_EQ(files.polycube_to_model.flipped + files.polycube_to_model.degenerate, 0);
   EXPECT_EQ(files.model_to_polycube.flipped + files.model_to_polycube.degenerate, 0);
   EXPECT_NEAR(files.polycube_to_model.area_ratio, 1, 0.01);
