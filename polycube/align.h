@@ -7,10 +7,9 @@
 // again: principal axes snapped to the coordinate axes can repeat the input frame's). Each gets
 // its polycube (under a small repair budget); the few with the fewest corners also get their
 // map, and the map with the fewest flipped image triangles (then the least ε_angle, then the
-// fewest corners) wins. When no candidate passes the
-// budget, they are tried again with four times the budget, then in order with the caller's full
-// budget, and the first that builds wins (an invalid polycube is never returned: build_polycube
-// throws instead).
+// fewest corners) wins. When no candidate passes the budget, they are tried again with four
+// times the budget, then in order with the caller's full budget, and the first that builds wins
+// (an invalid polycube is never returned: build_polycube throws instead).
 #pragma once
 
 #include "polycube/mesh.h"
