@@ -757,14 +757,11 @@ TEST(MapCli, BadInputFailsCleanlyAndWritesNothing) {
   // forty-first session this was the sphere flattened to 1e-6 of its height, with default
   // options; swept once through its thickness it now maps.)
   {
-    const TriMesh sphere = test::load_test_mesh("sphere.off");
-    std::ostringstream needle;
-    needle.precision(17);
-    needle << "OFF\n" << sphere.num_vertices() << " " << sphere.num_faces() << " 0\n";
-    for (int v = 0; v < sphere.num_vertices(); ++v)
-      needle << 1e-3 * sphere.V(v, 0) << " " << 1e-3 * sphere.V(v, 1) << " " << sphere.V(v, 2) << "\n";
-    for (int f = 0; f < sphere.num_faces(); ++f) needle << "3 " << sphere.F(f, 0) << " " << sphere.F(f, 1) << " " << sphere.F(f, 2) << "\n";
-    const std::string input = test::write_file(test::temp_dir("map-bad") + "/needle.off", needle.str());
+    TriMesh needle = test::load_test_mesh("sphere.off");
+    needle.V.col(0) *= 1e-3;
+    needle.V.col(1) *= 1e-3;
+    const std::string input = test::temp_dir("map-bad") + "/needle.off";
+    write_mesh(input, needle);
     run = polycube_cli("map --quiet --align none --equalise-axes never " + quoted(input) + " -o " + quoted(dir));
     EXPECT_EQ(run.code, 6) << run.err;
     EXPECT_EQ(test::line_count(run.err), 1) << run.err;
