@@ -219,7 +219,20 @@ struct Attempt : AlignedStages {
   double refine_seconds = 0, smooth_unrefined_seconds = 0, seconds = 0;
   std::string name;  // orientation (and finer contours)
   double da = 0;     // the d_a its polycube was built with
+  // Not run: its polycube is an earlier finished attempt's (same_polycube, same rotation and
+  // scales), whose map it would repeat bit for bit. That attempt's name.
+  std::string same_as;
 };
+
+// An earlier finished attempt whose stages `a` would repeat, or null.
+const Attempt* repeated_attempt(const std::vector<std::unique_ptr<Attempt>>& attempts, const Attempt& a) {
+  for (const std::unique_ptr<Attempt>& b : attempts) {
+    if (b.get() == &a) break;
+    if (b->finished && b->scales == a.scales && b->unscaled == a.unscaled && b->scaled() == a.scaled() && same_stages(*b, a))
+      return b.get();
+  }
+  return nullptr;
+}
 
 nlohmann::json polycube_json(const PolycubeResult& result) {
   const Polycube& p = result.polycube;
@@ -667,6 +680,11 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     for (size_t i = first; i < attempts.size(); ++i) {
       Attempt& a = *attempts[i];
       if (kept && time_limit.spent(progress)) return;
+      if (const Attempt* same = repeated_attempt(attempts, a)) {
+        a.same_as = same->name;
+        progress.stage("retry", a.name + ": the same polycube as " + same->name + ", not mapped again");
+        continue;
+      }
       if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
       run_stages(a, stages_source, pass, progress);
       if (a.finished) a.on_model = on_model_of(a, *a.finished);
@@ -813,6 +831,10 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     }
     report["alignment"]["finished"] = finished;
   }
+  nlohmann::json repeated = nlohmann::json::array();
+  for (const std::unique_ptr<Attempt>& a : attempts)
+    if (!a->same_as.empty()) repeated.push_back({{"name", a->name}, {"same_polycube_as", a->same_as}});
+  if (!repeated.empty()) report["alignment"]["repeated"] = repeated;
   report["alignment"]["rotation"] = {{rotation(0, 0), rotation(0, 1), rotation(0, 2)},
                                      {rotation(1, 0), rotation(1, 1), rotation(1, 2)},
                                      {rotation(2, 0), rotation(2, 1), rotation(2, 2)}};

@@ -232,6 +232,9 @@ struct QuadAttempt : AlignedStages {
   Eigen::Matrix3d unscaled = Eigen::Matrix3d::Identity();
   std::unique_ptr<Polycube> real_polycube;
   std::optional<QuadRemeshResult> result;
+  // Not remeshed: its stages repeat an earlier try's that has quads (same_stages, on the same
+  // model and copy), whose quads it would repeat. That try's name.
+  std::string same_as;
   double smooth_map_seconds = 0, seconds = 0;
   int bad() const { return result->quality.flipped_quads + result->quality.degenerate_quads; }
   bool too_far() const { return result->quality.hausdorff_measured && result->quality.hausdorff_percent > kHausdorffWarnPercent; }
@@ -554,6 +557,15 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
     for (size_t i = first; i < attempts.size(); ++i) {
       QuadAttempt& a = *attempts[i];
       if (kept && time_limit.spent(progress)) return;
+      const auto same = std::find_if(attempts.begin(), attempts.begin() + i, [&a](const std::unique_ptr<QuadAttempt>& b) {
+        return b->result && b->on == a.on && b->equalised == a.equalised && b->scales == a.scales && b->unscaled == a.unscaled &&
+               same_stages(*b, a);
+      });
+      if (same != attempts.begin() + i) {
+        a.same_as = (*same)->name;
+        progress.stage("retry", a.name + ": the same polycube as " + a.same_as + ", not remeshed again");
+        continue;
+      }
       if (kept) progress.stage("retry", shortfall() + a.name);
       if (!a.result) {
         try {
@@ -712,6 +724,10 @@ int run_quad(const QuadCommandOptions& options, const GlobalOptions& global) {
   for (const std::unique_ptr<QuadAttempt>& a : attempts)
     if (!a->given_up.empty()) given_up.push_back({{"name", a->name}, {"why", a->given_up}});
   if (!given_up.empty()) report["alignment"]["given_up"] = given_up;
+  nlohmann::json repeated = nlohmann::json::array();
+  for (const auto& a : attempts)
+    if (!a->same_as.empty()) repeated.push_back({{"name", a->name}, {"same_polycube_as", a->same_as}});
+  if (!repeated.empty()) report["alignment"]["repeated"] = repeated;
   if (kept->candidate >= 0) report["alignment"]["chosen"] = kept->name;
   if (options.map_dir.empty()) report["split"]["kept"] = kept->on->split;  // the quads are of the split model
   if (kept->topology) {

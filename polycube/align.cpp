@@ -561,4 +561,8 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
   return out;
 }
 
+bool same_stages(const AlignedStages& a, const AlignedStages& b) {
+  return a.polycube && b.polycube && a.rotation == b.rotation && same_polycube(*a.polycube, *b.polycube);
+}
+
 }  // namespace polycube

@@ -68,6 +68,10 @@ struct AlignedStages {
   std::shared_ptr<PolycubeResult> polycube;
   std::shared_ptr<PolycubeMap> map;
 };
+// Whether b's stages repeat a's: both polycubes built, the same rotation and the same polycube
+// (same_polycube). On the same model, with the same options after the polycube, the map and all
+// that follows are then the same (map and quad skip such an attempt of a later search).
+bool same_stages(const AlignedStages& a, const AlignedStages& b);
 struct Alignment {
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   int chosen = -1;

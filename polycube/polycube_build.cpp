@@ -526,4 +526,12 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
   return result;
 }
 
+bool same_polycube(const PolycubeResult& a, const PolycubeResult& b) {
+  const Polycube &p = a.polycube, &q = b.polycube;
+  return a.planes_z == b.planes_z && a.piece_match == b.piece_match && p.corners == q.corners &&
+         p.mesh.V.rows() == q.mesh.V.rows() && p.mesh.F.rows() == q.mesh.F.rows() && p.mesh.V == q.mesh.V &&
+         p.mesh.F == q.mesh.F && p.face_axis.size() == q.face_axis.size() && p.face_axis == q.face_axis &&
+         p.face_patch.size() == q.face_patch.size() && p.face_patch == q.face_patch;
+}
+
 }  // namespace polycube

@@ -136,6 +136,13 @@ struct PolycubeResult {
 // invalid polycube is never returned — and std::invalid_argument for inconsistent inputs.
 PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topology, const PolycubeOptions& options = {});
 
+// Whether two builds for the same model and topology gave the same polycube: the same planes,
+// P's triangles, vertex positions (exactly), face axes and patches, corners, and the same piece
+// matching. Everything later (the map, its refinement and finish) depends on nothing else, so a
+// caller may skip a build that repeats an earlier one: finer contours (d_a) often leave a coarse
+// CAD model's axis-aligned sections, and so P, as they were.
+bool same_polycube(const PolycubeResult& a, const PolycubeResult& b);
+
 // What build_polycube throws when its check-and-repair rounds (PolycubeOptions::max_rounds) run
 // out with slabs still failing: a budget that ran out, where more rounds may succeed, rather than a
 // cross-section that cannot be approximated within the limits.

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <string>
 #include <tuple>
+#include <vector>
 
 namespace polycube {
 namespace {
@@ -312,6 +313,36 @@ TEST(QuadCli, QuadsStillShortTryFinerContours) {
   EXPECT_GE(plain, 1u);
   EXPECT_GE(kept_thin, 1u);
   EXPECT_EQ(quad_topology(read_quads(dir + "/thin.obj")).genus(), 2);
+}
+
+// A try of a later search whose polycube is an earlier try's (same rotation, same P bit for bit,
+// same model) is not remeshed again: its quads would be the same. With d_a divided by 1.0001 no
+// section of eight changes, so every try of the finer-contours searches repeats one, and the
+// quads are those of a run without them.
+TEST(QuadCli, ATryWithTheSamePolycubeIsNotRemeshedAgain) {
+  const std::string dir = test::temp_dir("quad-repeated");
+  const std::string base =
+      "quad " + quoted(test::data_path("eight.off")) + " --target-faces 200 --refine 0 --refine-bound 0 --thin-parts 0 --quiet";
+  ASSERT_EQ(polycube_cli(base + " --finer-contours 1.0001 -o " + quoted(dir + "/repeated.obj") + " --report " +
+                         quoted(dir + "/repeated.json")).code, 0);
+  const nlohmann::json report = nlohmann::json::parse(test::read_file(dir + "/repeated.json"));
+  const nlohmann::json& alignment = report["alignment"];
+  ASSERT_TRUE(alignment.contains("finer_contours")) << "the finer-contours search did not run: pick another case";
+  ASSERT_TRUE(alignment.contains("repeated"));
+  std::vector<std::string> tried;
+  for (const nlohmann::json& t : alignment["tried"]) {
+    tried.push_back(t["name"].get<std::string>());
+    EXPECT_EQ(tried.back().find("finer contours"), std::string::npos) << tried.back() << " was remeshed again";
+  }
+  EXPECT_EQ(alignment["repeated"].size(), tried.size());
+  for (const nlohmann::json& r : alignment["repeated"]) {
+    const std::string name = r["name"].get<std::string>(), same = r["same_polycube_as"].get<std::string>();
+    EXPECT_EQ(std::count(tried.begin(), tried.end(), same), 1) << same;
+    EXPECT_NE(name.find(", finer contours (d_a 0.29997)"), std::string::npos) << name;
+  }
+  ASSERT_EQ(polycube_cli(base + " --finer-contours 1 -o " + quoted(dir + "/once.obj") + " --report " + quoted(dir + "/once.json")).code, 0);
+  EXPECT_FALSE(nlohmann::json::parse(test::read_file(dir + "/once.json"))["alignment"].contains("repeated"));
+  EXPECT_EQ(test::read_file(dir + "/repeated.obj"), test::read_file(dir + "/once.obj"));
 }
 
 // --time-limit: once the first try has quads, no further try starts after the limit. Eight at 200

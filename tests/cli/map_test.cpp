@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <set>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -362,6 +363,41 @@ TEST(MapCli, AMapShortOfTheContractIsFinishedAgainWithFinerContours) {
   EXPECT_FALSE(first.at("alignment").contains("finer_contours"));
   EXPECT_DOUBLE_EQ(first.at("polycube").at("da").get<double>(), 1.0);
   EXPECT_GT(std::abs(first.at("map").at("polycube_to_model").at("area_ratio").get<double>() - 1), 0.02);
+}
+
+// An attempt of the finer-contours search whose polycube is a finished attempt's (same rotation,
+// same P bit for bit) is not mapped again: its map would be the same. With d_a divided by 1.0001
+// none of eight's sections changes, so every attempt of the second search repeats one of the
+// first, and the files are those of a run without the second search.
+TEST(MapCli, AnAttemptWithTheSamePolycubeIsNotMappedAgain) {
+  const std::string coarse =
+      "map --quiet --da 1 --no-refine --untangle-shift 0 --no-exact " + quoted(test::data_path("eight.off"));
+  const std::string dir = test::temp_dir("map-repeated");
+  const CliRun run = polycube_cli(coarse + " --finer-contours 1.0001 -o " + quoted(dir));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  const auto& alignment = report.at("alignment");
+  ASSERT_TRUE(alignment.contains("finer_contours")) << "the second search did not run: pick another case";
+  ASSERT_TRUE(alignment.contains("repeated"));
+  std::set<std::string> first_pass;
+  for (const auto& f : alignment.at("finished")) {
+    const std::string name = f.at("name").get<std::string>();
+    EXPECT_EQ(name.find("finer contours"), std::string::npos) << name << " was mapped again";
+    first_pass.insert(name);
+  }
+  const auto& repeated = alignment.at("repeated");
+  EXPECT_EQ(repeated.size(), first_pass.size());
+  for (const auto& r : repeated) {
+    const std::string name = r.at("name").get<std::string>(), same = r.at("same_polycube_as").get<std::string>();
+    EXPECT_EQ(name, same + ", finer contours (d_a 0.9999)");
+    EXPECT_EQ(first_pass.count(same), 1u) << same;
+  }
+  const std::string once = test::temp_dir("map-repeated-off");
+  const CliRun off = polycube_cli(coarse + " --finer-contours 1 -o " + quoted(once));
+  ASSERT_EQ(off.code, 0) << off.err;
+  EXPECT_FALSE(read_json(once + "/report.json").at("alignment").contains("repeated"));
+  for (const char* file : {"polycube.obj", "polycube_on_model.obj", "model_on_polycube.obj"})
+    EXPECT_EQ(test::read_file(dir + "/" + file), test::read_file(once + "/" + file)) << file;
 }
 
 // The last untangling of the files (image_untangle.h): on CGAL's rotor.off (1200 triangles), a

@@ -379,6 +379,30 @@ TEST(Polycube, SmallerDaAloneGivesACloserShape) {
   }
 }
 
+// same_polycube tells a build that repeats another (map: a finer-contours attempt not mapped
+// again) from one that does not: a box's square sections are the same at any d_a, a sphere's
+// round ones are not, and another triangulation of the same P is another P.
+TEST(Polycube, SamePolycubeIsTheSameBuildOnly) {
+  const TriMesh box = gridded_unit_cube(6);
+  const TopologyResult box_topology = analyse_topology(box);
+  PolycubeOptions coarse, fine, denser;
+  fine.da = coarse.da / 3;
+  denser.min_vertices = 4 * box.num_vertices();
+  const PolycubeResult box_coarse = build(box, box_topology, coarse);
+  EXPECT_TRUE(same_polycube(box_coarse, build(box, box_topology, coarse)));
+  EXPECT_TRUE(same_polycube(box_coarse, build(box, box_topology, fine)));
+  const PolycubeResult box_denser = build(box, box_topology, denser);
+  ASSERT_EQ(box_denser.polycube.corners.size(), box_coarse.polycube.corners.size());
+  EXPECT_FALSE(same_polycube(box_coarse, box_denser));
+  const TriMesh sphere = test::make_genus_surface(0, 32);
+  const TopologyResult sphere_topology = analyse_topology(sphere);
+  const PolycubeResult sphere_coarse = build(sphere, sphere_topology, coarse);
+  const PolycubeResult sphere_fine = build(sphere, sphere_topology, fine);
+  ASSERT_NE(sphere_fine.polycube.corners.size(), sphere_coarse.polycube.corners.size());
+  EXPECT_FALSE(same_polycube(sphere_coarse, sphere_fine));
+  EXPECT_FALSE(same_polycube(sphere_fine, sphere_coarse));
+}
+
 TEST(Polycube, TargetVertexCountSetsTheResolution) {
   const TriMesh mesh = test::make_sphere(3);
   const TopologyResult topology = analyse_topology(mesh);
