@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -707,10 +708,46 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
   const int nthreads = threads_for(threads);
   std::vector<int> parts(nthreads);
   std::iota(parts.begin(), parts.end(), 0);
+  constexpr std::array<int, 4> kChartDepths = {4, 8, 16, 40};
   parallel_for_each(parts, nthreads, "part", [&](int part) {
     Chart chart(M);
     std::vector<int> tested(PM.num_faces(), -1);
     int search = 0;
+    // The least depth of a chart of w that can hold a P triangle whole (its three corners imaged
+    // in faces of the chart), or kChartDepths.back() + 1: a chart of depth d holds only faces
+    // within d steps across edges of its seed face (Chart::build), so in a shallower one neither
+    // the walk nor the search below can find w. Breadth-first from the seed face. (A coarse
+    // model's vertices imaged on a fine P are mostly farther than any chart reaches from the P
+    // vertices they are located for: their charts were built and searched in vain.)
+    std::vector<int> ball_stamp(M.mesh().num_faces(), 0);
+    std::vector<int> frontier, next;
+    int ball = 0;
+    auto least_depth = [&](int w) {
+      const int max_depth = kChartDepths.back();
+      ++ball;
+      const int seed = *M.faces_of().first(w);
+      frontier.assign(1, seed);
+      ball_stamp[seed] = ball;
+      for (int d = 0; d <= max_depth; ++d) {
+        for (const int f : frontier)
+          for (const int* v = images_in.first(f); v != images_in.last(f); ++v)
+            for (const int* t = P.faces_of().first(*v); t != P.faces_of().last(*v); ++t)
+              if (ball_stamp[y[PM.F(*t, 0)].face] == ball && ball_stamp[y[PM.F(*t, 1)].face] == ball &&
+                  ball_stamp[y[PM.F(*t, 2)].face] == ball)
+                return d;
+        if (d == max_depth) break;
+        next.clear();
+        for (const int f : frontier)
+          for (int i = 0; i < 3; ++i) {
+            const int g = M.across()(f, i);
+            if (ball_stamp[g] == ball) continue;
+            ball_stamp[g] = ball;
+            next.push_back(g);
+          }
+        frontier.swap(next);
+      }
+      return max_depth + 1;
+    };
     auto corners = [&](int T, Vec2& a, Vec2& b, Vec2& c) {
       const int i = PM.F(T, 0), j = PM.F(T, 1), k = PM.F(T, 2);
       if (!chart.in_chart(y[i].face) || !chart.in_chart(y[j].face) || !chart.in_chart(y[k].face)) return false;
@@ -753,8 +790,10 @@ std::vector<SurfacePoint> locate_model_vertices(const Surface& M, const Surface&
         }
         return (yy[1] - yy[0]).cross(yy[2] - yy[0]).dot(nn[0] + nn[1] + nn[2]) > 0 && normal_prism_coordinates(yy, nn, x, bary);
       });
-      for (int depth : {4, 8, 16, 40}) {
+      const int least = found ? 0 : least_depth(w);
+      for (const int depth : kChartDepths) {
         if (found) break;
+        if (depth < least) continue;
         chart.build(w, depth);
         const Vec2 target = chart.position(w);
         found = walk(1000, [&](int T, Vec3& bary) {
