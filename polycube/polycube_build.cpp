@@ -528,10 +528,27 @@ PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topolo
 
 bool same_polycube(const PolycubeResult& a, const PolycubeResult& b) {
   const Polycube &p = a.polycube, &q = b.polycube;
-  return a.planes_z == b.planes_z && a.piece_match == b.piece_match && p.corners == q.corners &&
-         p.mesh.V.rows() == q.mesh.V.rows() && p.mesh.F.rows() == q.mesh.F.rows() && p.mesh.V == q.mesh.V &&
-         p.mesh.F == q.mesh.F && p.face_axis.size() == q.face_axis.size() && p.face_axis == q.face_axis &&
-         p.face_patch.size() == q.face_patch.size() && p.face_patch == q.face_patch;
+  const auto same_sections = [](const std::vector<std::vector<SectionPolygon>>& x, const std::vector<std::vector<SectionPolygon>>& y) {
+    if (x.size() != y.size()) return false;
+    for (size_t i = 0; i < x.size(); ++i) {
+      if (x[i].size() != y[i].size()) return false;
+      for (size_t k = 0; k < x[i].size(); ++k)
+        if (x[i][k].contour != y[i][k].contour || x[i][k].points != y[i][k].points) return false;
+    }
+    return true;
+  };
+  const auto same_edges = [](const std::vector<PolycubeEdge>& x, const std::vector<PolycubeEdge>& y) {
+    if (x.size() != y.size()) return false;
+    for (size_t i = 0; i < x.size(); ++i)
+      if (x[i].vertices != y[i].vertices || x[i].axis != y[i].axis || x[i].faces[0] != y[i].faces[0] || x[i].faces[1] != y[i].faces[1])
+        return false;
+    return true;
+  };
+  return a.planes_z == b.planes_z && a.piece_match == b.piece_match && a.polycube_piece_contours == b.polycube_piece_contours &&
+         p.corners == q.corners && p.vertices == q.vertices && p.levels == q.levels && p.spacing == q.spacing &&
+         p.mesh.V.rows() == q.mesh.V.rows() && p.mesh.F.rows() == q.mesh.F.rows() && p.mesh.V == q.mesh.V && p.mesh.F == q.mesh.F &&
+         p.face_axis.size() == q.face_axis.size() && p.face_axis == q.face_axis && p.face_patch.size() == q.face_patch.size() &&
+         p.face_patch == q.face_patch && same_edges(p.edges, q.edges) && same_sections(p.sections, q.sections);
 }
 
 }  // namespace polycube

@@ -137,8 +137,8 @@ struct PolycubeResult {
 PolycubeResult build_polycube(const TriMesh& model, const TopologyResult& topology, const PolycubeOptions& options = {});
 
 // Whether two builds for the same model and topology gave the same polycube: the same planes,
-// P's triangles, vertex positions (exactly), face axes and patches, corners, and the same piece
-// matching. Everything later (the map, its refinement and finish) depends on nothing else, so a
+// P's triangles, vertex positions (exactly), face axes and patches, edges, vertices, corners,
+// levels, spacing and section loops, and the same piece matching and contours. Everything later (the map, its refinement and finish) depends on nothing else, so a
 // caller may skip a build that repeats an earlier one: finer contours (d_a) often leave a coarse
 // CAD model's axis-aligned sections, and so P, as they were.
 bool same_polycube(const PolycubeResult& a, const PolycubeResult& b);
