@@ -70,6 +70,11 @@ struct MapOptions {
   // When no finished map of the orientation search meets the contract, the search and its maps
   // run once more with d_a divided by this (finer contours); 1: never.
   double finer_contours = 3;
+  // When no finished map meets the contract after the finer contours and the exact samplings,
+  // more of the first search's orientations are finished (best by its score first; each sampled
+  // exactly too when it misses), each started while those before took less than this many times
+  // the run's time before them (the first always); 0: none.
+  double more_orientations = 1;
   // When no finished map (every orientation, finer contours included) meets the contract, the
   // exact sampling of their unsmoothed maps (map_overlay.h), best-ranked first, kept where it
   // ranks better.
@@ -580,6 +585,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
   report["parameters"]["untangle_shift"] = options.untangle_shift;
   report["parameters"]["untangle_shift_max"] = options.untangle_shift_max;
   report["parameters"]["finer_contours"] = options.finer_contours;
+  report["parameters"]["more_orientations"] = options.more_orientations;
   TimeLimit time_limit = options.time_limit;
   std::vector<std::string> outputs;
   // Self-intersecting: every stage runs on the separated copy; P's images on it go back to the
@@ -623,6 +629,41 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
     }
     return m;
   };
+  // Finishes attempts [first, end) in order until one meets the contract; the best by rank is
+  // kept. An attempt stopped before the map (--stage) ends the pass unfinished; with
+  // skip_failures, one whose stages fail is left unfinished (a warning) and the next follows.
+  auto finish_attempts = [&](size_t first, const MapOptions& pass, const TriMesh& stages_source, bool skip_failures) {
+    for (size_t i = first; i < attempts.size(); ++i) {
+      Attempt& a = *attempts[i];
+      if (kept && time_limit.spent(progress)) return;
+      if (const Attempt* same = repeated_attempt(attempts, a)) {
+        a.same_as = same->name;
+        progress.stage("retry", a.name + ": the same polycube as " + same->name + ", not mapped again");
+        continue;
+      }
+      if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
+      if (skip_failures) {
+        try {
+          run_stages(a, stages_source, pass, progress);
+        } catch (const Error& e) {
+          progress.warning(a.name + ": " + e.what());
+          a.finished.reset();
+          continue;
+        }
+      } else {
+        run_stages(a, stages_source, pass, progress);
+      }
+      if (a.finished) a.on_model = on_model_of(a, *a.finished);
+      if (!a.finished) {
+        kept = &a;
+        return;
+      }
+      if (!kept || a.judged().rank() < kept->judged().rank()) kept = &a;
+      if (kept->judged().meets_contract()) return;
+    }
+  };
+  // The first search's other orientations built (Alignment::reserve) with their names.
+  std::vector<std::pair<AlignedStages, std::string>> reserve;
   // A pass on a long model's scaled copy (equalised) runs its stages on the copy.
   auto run_pass = [&](const MapOptions& pass, nlohmann::json& alignment_report, const std::string& suffix,
                       const EqualisedCopy* equalised = nullptr) {
@@ -659,6 +700,8 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
         throw AlgorithmError("no orientation gives a valid polycube; in the input frame: " + alignment.candidates.front().error);
       const AlignmentCandidate& chosen = alignment.candidates[alignment.chosen];
       alignment_report["chosen"] = chosen.name + suffix;
+      if (!equalised && reserve.empty() && &pass == &options)
+        for (const AlignedStages& r : alignment.reserve) reserve.emplace_back(r, alignment.candidates[r.candidate].name + suffix);
       progress.stage("align", chosen.name + suffix + " (" + std::to_string(chosen.corners) + " corners)");
     }
     const size_t first = attempts.size();
@@ -677,24 +720,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       }
     }
     if (first_choice.empty()) first_choice = attempts[first]->name;
-    for (size_t i = first; i < attempts.size(); ++i) {
-      Attempt& a = *attempts[i];
-      if (kept && time_limit.spent(progress)) return;
-      if (const Attempt* same = repeated_attempt(attempts, a)) {
-        a.same_as = same->name;
-        progress.stage("retry", a.name + ": the same polycube as " + same->name + ", not mapped again");
-        continue;
-      }
-      if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
-      run_stages(a, stages_source, pass, progress);
-      if (a.finished) a.on_model = on_model_of(a, *a.finished);
-      if (!a.finished) {
-        kept = &a;
-        return;
-      }
-      if (!kept || a.judged().rank() < kept->judged().rank()) kept = &a;
-      if (kept->judged().meets_contract()) return;
-    }
+    finish_attempts(first, pass, stages_source, false);
   };
   // A model much longer than wide: first on its scaled copy (equalised_copy); the model itself
   // follows when that map misses the contract, is far from conformal (kEqualiseKeepAngle) or
@@ -745,53 +771,87 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       progress.warning(std::string("finer contours: ") + e.what());
     }
   }
+  // The exact sampling of a finished attempt's unsmoothed φ (exact_map), kept in its place where
+  // it ranks better; the kept attempt updated.
+  auto try_exact = [&](Attempt* a) {
+    progress.stage("retry", shortfall() + "the exact sampling of " + a->name);
+    const double start = progress.elapsed_seconds();
+    std::unique_ptr<Finished> exact;
+    try {
+      exact = exact_map(a->model, a->polycube->polycube, *a->map, options, progress);
+    } catch (const AlgorithmError& e) {
+      // Not a result: the finished map stands.
+      progress.warning(std::string("exact sampling not made: ") + e.what());
+      a->finished->overlay = {{"error", e.what()}};
+      a->seconds += progress.elapsed_seconds() - start;
+      return;
+    }
+    std::unique_ptr<Finished> exact_on_model = on_model_of(*a, *exact);
+    const Finished &judged_exact = exact_on_model ? *exact_on_model : *exact, &judged_before = a->judged();
+    const bool better = judged_exact.rank() < judged_before.rank();
+    progress.stage("exact", std::string(better ? "kept" : "not kept") + " (" + std::to_string(judged_exact.bad_p()) + " / " +
+                                std::to_string(judged_exact.bad_m()) + " flipped, image area " +
+                                std::to_string(judged_exact.audit.polycube_to_model.area_ratio) + " against " +
+                                std::to_string(judged_before.bad_p()) + " / " + std::to_string(judged_before.bad_m()) + ", " +
+                                std::to_string(judged_before.audit.polycube_to_model.area_ratio) +
+                                (exact_on_model ? ", on the model)" : ")"));
+    nlohmann::json tried = exact->overlay;
+    tried["kept"] = better;
+    tried["polycube_to_model"] = direction_json(exact->audit.polycube_to_model);
+    tried["model_to_polycube"] = direction_json(exact->audit.model_to_polycube);
+    tried["seconds_total"] = progress.elapsed_seconds() - start;  // the sampling and its untangling
+    if (better) {
+      a->finished = std::move(exact);
+      a->on_model = std::move(exact_on_model);
+    }
+    a->finished->overlay = tried;
+    a->seconds += progress.elapsed_seconds() - start;
+    if (a->judged().rank() < kept->judged().rank()) kept = a;
+  };
+  // (A scaled copy's map data is the copy's: no exact sampling of it.)
+  const auto exact_possible = [&](const Attempt& a) { return options.exact && a.finished && a.map && !a.scaled(); };
   // Still short after every orientation and the finer contours: the exact sampling of each
-  // finished map's unsmoothed φ (exact_map), best-ranked first, until one meets the contract. Not
-  // earlier: where a smoothed map meets the contract it has the lower distortion (joint:
-  // ε_angle 1.03 smoothed, after its second orientation, against 2.10 exact on its first).
+  // finished map, best-ranked first, until one meets the contract. Not earlier: where a smoothed
+  // map meets the contract it has the lower distortion (joint: ε_angle 1.03 smoothed, after its
+  // second orientation, against 2.10 exact on its first).
   if (options.exact && kept && kept->finished && !kept->judged().meets_contract()) {
     std::vector<Attempt*> order;
     for (const auto& a : attempts)
-      if (a->finished && a->map && !a->scaled()) order.push_back(a.get());  // (a scaled copy's map data is the copy's)
+      if (exact_possible(*a)) order.push_back(a.get());
     std::stable_sort(order.begin(), order.end(), [](const Attempt* x, const Attempt* y) { return x->judged().rank() < y->judged().rank(); });
     for (Attempt* a : order) {
       if (time_limit.spent(progress)) break;
-      progress.stage("retry", shortfall() + "the exact sampling of " + a->name);
-      const double start = progress.elapsed_seconds();
-      std::unique_ptr<Finished> exact;
-      try {
-        exact = exact_map(a->model, a->polycube->polycube, *a->map, options, progress);
-      } catch (const AlgorithmError& e) {
-        // Not a result: the finished map stands.
-        progress.warning(std::string("exact sampling not made: ") + e.what());
-        a->finished->overlay = {{"error", e.what()}};
-        a->seconds += progress.elapsed_seconds() - start;
-        continue;
-      }
-      std::unique_ptr<Finished> exact_on_model = on_model_of(*a, *exact);
-      const Finished &judged_exact = exact_on_model ? *exact_on_model : *exact, &judged_before = a->judged();
-      const bool better = judged_exact.rank() < judged_before.rank();
-      progress.stage("exact", std::string(better ? "kept" : "not kept") + " (" + std::to_string(judged_exact.bad_p()) + " / " +
-                                  std::to_string(judged_exact.bad_m()) + " flipped, image area " +
-                                  std::to_string(judged_exact.audit.polycube_to_model.area_ratio) + " against " +
-                                  std::to_string(judged_before.bad_p()) + " / " + std::to_string(judged_before.bad_m()) + ", " +
-                                  std::to_string(judged_before.audit.polycube_to_model.area_ratio) +
-                                  (exact_on_model ? ", on the model)" : ")"));
-      nlohmann::json tried = exact->overlay;
-      tried["kept"] = better;
-      tried["polycube_to_model"] = direction_json(exact->audit.polycube_to_model);
-      tried["model_to_polycube"] = direction_json(exact->audit.model_to_polycube);
-      tried["seconds_total"] = progress.elapsed_seconds() - start;  // the sampling and its untangling
-      if (better) {
-        a->finished = std::move(exact);
-        a->on_model = std::move(exact_on_model);
-      }
-      a->finished->overlay = tried;
-      a->seconds += progress.elapsed_seconds() - start;
-      if (a->judged().rank() < kept->judged().rank()) kept = a;
+      try_exact(a);
       if (kept->judged().meets_contract()) break;
     }
   }
+  // Still short after the exact samplings too: the first search's other orientations (its
+  // reserve), best by its score first, each finished and, short of the contract, sampled exactly;
+  // each started while those before took less than --more-orientations times the run's time before
+  // them. The score (unsmoothed flips) is a weak guide to the finished map: on Cura's
+  // Hellbot_Magna_2_230 plate (260 triangles) the three maps finished first, their finer contours
+  // and exact samplings all missed; the fourth more orientation's exact sampling met the contract.
+  // Last, so that a map meeting the contract before keeps its files and its time.
+  if (kept && kept->finished && !kept->judged().meets_contract() && !reserve.empty() && options.more_orientations > 0 &&
+      !time_limit.spent(progress)) {
+    const double start = progress.elapsed_seconds(), budget = options.more_orientations * start;
+    progress.stage("retry", shortfall() + "more of the search's orientations (" + std::to_string(reserve.size()) + " built)");
+    int more = 0;
+    for (const auto& [stages, name] : reserve) {
+      if (progress.elapsed_seconds() - start >= budget && more > 0) break;
+      attempts.push_back(std::make_unique<Attempt>());
+      static_cast<AlignedStages&>(*attempts.back()) = stages;
+      attempts.back()->name = name;
+      attempts.back()->da = options.polycube.da;
+      ++more;
+      finish_attempts(attempts.size() - 1, options, source, true);
+      Attempt& a = *attempts.back();
+      if (!kept->judged().meets_contract() && exact_possible(a) && !a.judged().meets_contract() && !time_limit.spent(progress)) try_exact(&a);
+      if (kept->judged().meets_contract() || time_limit.spent(progress)) break;
+    }
+    report["alignment"]["more_orientations"] = more;
+  }
+  reserve.clear();
   time_limit.warn(progress, "other orientations, finer contours and exact samplings");
   if (time_limit.seconds > 0) report["time_limit"] = {{"seconds", time_limit.seconds}, {"reached", time_limit.reached}};
   if (separation && kept->finished) {
@@ -1057,6 +1117,13 @@ void add_map_command(CLI::App& app, const GlobalOptions& global, CommandRunner& 
                       "When the finished map still has flipped triangles or misses area, finish the kept orientation once more with d_a "
                       "divided by this (finer contours keep thin parts such as tails and horns); 1: never")
       ->check(CLI::Range(1.0, 100.0))
+      ->capture_default_str();
+  command->add_option("--more-orientations", options->more_orientations,
+                      "When no map meets the contract after the finer contours and the exact samplings, finish more of the "
+                      "orientations the search built (and sample each exactly when it misses), best by its score first, until one "
+                      "meets it, each started while they have taken less than this many times the run's time before them (the first "
+                      "always); 0: none")
+      ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
   add_time_limit_option(*command, options->time_limit);
   command->add_flag("--no-exact{false}", options->exact,

@@ -553,9 +553,18 @@ Alignment choose_alignment(const TriMesh& mesh, const TopologyOptions& topology,
     const auto twin = std::find_if(others.begin(), others.end(), [&](int i) { return (i >= first_finer) != chosen_finer; });
     if (twin != others.end()) std::rotate(others.begin(), twin, twin + 1);
     for (int i : others) {
-      if (static_cast<int>(out.alternatives.size()) >= options.alternatives) break;
-      out.alternatives.push_back({i, out.candidates[i].rotation, topologies[i], polycubes[i], maps[i]});
+      if (static_cast<int>(out.alternatives.size()) < options.alternatives)
+        out.alternatives.push_back({i, out.candidates[i].rotation, topologies[i], polycubes[i], maps[i]});
+      else
+        out.reserve.push_back({i, out.candidates[i].rotation, topologies[i], polycubes[i], nullptr});
     }
+    // Then those built but not mapped (the search found a clean map among the first), fewest
+    // corners first.
+    std::vector<int> unmapped;
+    for (int i = 0; i < n; ++i)
+      if (i != out.chosen && !maps[i] && polycubes[i] && out.candidates[i].error.empty()) unmapped.push_back(i);  // (not a failed map)
+    std::stable_sort(unmapped.begin(), unmapped.end(), [&](int a, int b) { return key(a) < key(b); });
+    for (int i : unmapped) out.reserve.push_back({i, out.candidates[i].rotation, topologies[i], polycubes[i], nullptr});
   }
   if (out.chosen >= 0) out.rotation = out.candidates[out.chosen].rotation;
   return out;

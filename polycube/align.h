@@ -82,6 +82,12 @@ struct Alignment {
   int proxy_faces = 0;
   bool stopped = false;
   std::vector<AlignedStages> alternatives;
+  // The other candidates built (neither the winner nor an alternative), best by the score first
+  // (mapped ones before the rest), with their topology and polycube; map null (it is rebuilt,
+  // the same, if asked for: holding every candidate's map would hold memory few callers use).
+  // For a caller whose winner and alternatives all finish short of what it needs. Never on the
+  // proxy.
+  std::vector<AlignedStages> reserve;
   // The winner's stages, then the alternatives'. With no winner (nothing chosen, or no search
   // run): one entry with the identity and nothing built, for the caller to build in the input
   // frame.

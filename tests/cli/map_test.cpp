@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <set>
 #include <string>
@@ -284,7 +285,9 @@ TEST(MapCli, TimeLimitStopsFurtherTries) {
 // are its, in its frame.
 TEST(MapCli, AFinishedMapShortOfTheContractTriesTheNextCandidates) {
   const std::string dir = test::temp_dir("map-retry");
-  const CliRun run = polycube_cli("map --quiet --untangle-shift 0 " + quoted(test::data_path("helmet.off")) + " -o " + quoted(dir));
+  // (Not the search's further orientations: none meets the contract either, and they take time.)
+  const CliRun run = polycube_cli("map --quiet --untangle-shift 0 --more-orientations 0 " + quoted(test::data_path("helmet.off")) + " -o " +
+                                  quoted(dir));
   ASSERT_EQ(run.code, 0) << run.err;
   const auto report = read_json(dir + "/report.json");
   ASSERT_TRUE(report.at("alignment").contains("finished")) << "the winner's finished map met the contract: pick another mesh";
@@ -357,7 +360,7 @@ TEST(MapCli, AMapShortOfTheContractIsFinishedAgainWithFinerContours) {
 
   const std::string once = test::temp_dir("map-finer-off");
   // (Without the exact sampling too, which would otherwise meet the contract last.)
-  const CliRun off = polycube_cli(coarse + " --finer-contours 1 --no-exact -o " + quoted(once));
+  const CliRun off = polycube_cli(coarse + " --finer-contours 1 --no-exact --more-orientations 0 -o " + quoted(once));
   ASSERT_EQ(off.code, 0) << off.err;
   const auto first = read_json(once + "/report.json");
   EXPECT_FALSE(first.at("alignment").contains("finer_contours"));
@@ -371,7 +374,7 @@ TEST(MapCli, AMapShortOfTheContractIsFinishedAgainWithFinerContours) {
 // first, and the files are those of a run without the second search.
 TEST(MapCli, AnAttemptWithTheSamePolycubeIsNotMappedAgain) {
   const std::string coarse =
-      "map --quiet --da 1 --no-refine --untangle-shift 0 --no-exact " + quoted(test::data_path("eight.off"));
+      "map --quiet --da 1 --no-refine --untangle-shift 0 --no-exact --more-orientations 0 " + quoted(test::data_path("eight.off"));
   const std::string dir = test::temp_dir("map-repeated");
   const CliRun run = polycube_cli(coarse + " --finer-contours 1.0001 -o " + quoted(dir));
   ASSERT_EQ(run.code, 0) << run.err;
@@ -398,6 +401,73 @@ TEST(MapCli, AnAttemptWithTheSamePolycubeIsNotMappedAgain) {
   EXPECT_FALSE(read_json(once + "/report.json").at("alignment").contains("repeated"));
   for (const char* file : {"polycube.obj", "polycube_on_model.obj", "model_on_polycube.obj"})
     EXPECT_EQ(test::read_file(dir + "/" + file), test::read_file(once + "/" + file)) << file;
+}
+
+// When every finished map misses the contract, the finer contours' too, further orientations the
+// first search built (its reserve) are finished, best by its score (unsmoothed flips, then
+// eps_angle, then corners) first, each started while they have taken less than --more-orientations
+// times the run's time before them (the first always), until one meets it. Eight at d_a 1,
+// unrefined and not untangled, misses the area on its first three maps (0.963-0.965); with a
+// factor of 1000 the others follow in the score's order until one meets the contract (the eighth
+// of nine), which is kept; with 1e-9 only the first of them; with 0 none.
+TEST(MapCli, MapsShortOfTheContractAreFollowedByTheSearchsOtherOrientations) {
+  const std::string coarse = "map --quiet --da 1 --no-refine --untangle-shift 0 --finer-contours 1 --no-exact " +
+                             quoted(test::data_path("eight.off"));
+  const std::string dir = test::temp_dir("map-more");
+  const CliRun run = polycube_cli(coarse + " --more-orientations 1000 -o " + quoted(dir));
+  ASSERT_EQ(run.code, 0) << run.err;
+  const auto report = read_json(dir + "/report.json");
+  const auto& alignment = report.at("alignment");
+  const auto& finished = alignment.at("finished");
+  ASSERT_GE(finished.size(), 4u);
+  for (size_t i = 0; i + 1 < finished.size(); ++i)
+    EXPECT_FALSE(finished.at(i).at("meets_contract").get<bool>()) << "no further map after one meets it: " << finished.at(i).at("name");
+  std::map<std::string, nlohmann::json> candidates;
+  int built = 0;
+  for (const auto& c : alignment.at("candidates")) {
+    candidates[c.at("name").get<std::string>()] = c;
+    built += c.at("corners").get<int>() >= 0;
+  }
+  EXPECT_EQ(alignment.at("more_orientations").get<int>(), static_cast<int>(finished.size()) - 3);
+  ASSERT_TRUE(finished.back().at("meets_contract").get<bool>()) << "none of the more met it: pick another case";
+  EXPECT_TRUE(finished.back().at("kept").get<bool>());
+  EXPECT_LT(finished.size(), static_cast<size_t>(built)) << "the more end at the first that meets the contract";
+  std::set<std::string> names;
+  for (const auto& f : finished) EXPECT_TRUE(names.insert(f.at("name").get<std::string>()).second) << f.at("name") << " twice";
+  // The more: search candidates, those it mapped first, each in the order of its score.
+  const auto score = [](const nlohmann::json& c) {
+    return std::make_tuple(c.at("flipped").get<int>() < 0, c.at("flipped").get<int>(), c.at("eps_angle").get<double>(),
+                           c.at("corners").get<int>());
+  };
+  for (size_t i = 3; i < finished.size(); ++i) {
+    const std::string name = finished.at(i).at("name").get<std::string>();
+    ASSERT_EQ(candidates.count(name), 1u) << name;
+    if (i > 3) {
+      EXPECT_LE(score(candidates.at(finished.at(i - 1).at("name").get<std::string>())), score(candidates.at(name))) << name;
+    }
+  }
+  int kept = -1;
+  for (size_t i = 0; i < finished.size(); ++i)
+    if (finished.at(i).at("kept").get<bool>()) kept = static_cast<int>(i);
+  ASSERT_GE(kept, 0);
+  for (const auto& f : finished) EXPECT_LE(finished_rank(finished.at(kept)), finished_rank(f));
+  EXPECT_EQ(alignment.at("chosen").get<std::string>(), finished.at(kept).at("name").get<std::string>());
+  EXPECT_EQ(tilted_faces(dir + "/polycube.obj", report_rotation(report)), 0);
+
+  const std::string one = test::temp_dir("map-more-one");
+  const CliRun first = polycube_cli(coarse + " --more-orientations 1e-9 -o " + quoted(one));
+  ASSERT_EQ(first.code, 0) << first.err;
+  const auto only = read_json(one + "/report.json").at("alignment");
+  EXPECT_EQ(only.at("more_orientations").get<int>(), 1);
+  ASSERT_EQ(only.at("finished").size(), 4u);
+  EXPECT_EQ(only.at("finished").at(3).at("name"), finished.at(3).at("name"));
+
+  const std::string none = test::temp_dir("map-more-off");
+  const CliRun off = polycube_cli(coarse + " --more-orientations 0 -o " + quoted(none));
+  ASSERT_EQ(off.code, 0) << off.err;
+  const auto without = read_json(none + "/report.json").at("alignment");
+  EXPECT_FALSE(without.contains("more_orientations"));
+  EXPECT_EQ(without.at("finished").size(), 3u);
 }
 
 // The last untangling of the files (image_untangle.h): on CGAL's rotor.off (1200 triangles), a

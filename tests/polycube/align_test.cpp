@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
@@ -395,6 +396,29 @@ TEST(Align, ChoosesTheMappedCandidateWithFewestFlips) {
     if (c.flipped < 0 || static_cast<int>(i) == a.chosen || static_cast<int>(i) == a.alternatives[0].candidate) continue;
     EXPECT_TRUE(c.flipped > second.flipped || (c.flipped == second.flipped && c.eps_angle >= second.eps_angle)) << c.name;
   }
+  // The reserve: every other candidate built, once, with its topology and polycube but no map,
+  // the mapped ones by the score first.
+  std::set<int> listed{a.chosen, a.alternatives[0].candidate, a.alternatives[1].candidate};
+  for (size_t k = 0; k < a.reserve.size(); ++k) {
+    const AlignedStages& s = a.reserve[k];
+    ASSERT_GE(s.candidate, 0);
+    EXPECT_TRUE(listed.insert(s.candidate).second) << a.candidates[s.candidate].name << " listed twice";
+    ASSERT_TRUE(s.topology && s.polycube) << a.candidates[s.candidate].name;
+    EXPECT_FALSE(s.map);
+    EXPECT_EQ(s.rotation, a.candidates[s.candidate].rotation);
+    EXPECT_EQ(static_cast<int>(s.polycube->polycube.corners.size()), a.candidates[s.candidate].corners);
+    if (k == 0) continue;
+    const AlignmentCandidate &before = a.candidates[a.reserve[k - 1].candidate], &c = a.candidates[s.candidate];
+    if (before.flipped < 0) {
+      EXPECT_LT(c.flipped, 0) << "a mapped candidate after an unmapped one";
+    } else if (c.flipped >= 0) {
+      EXPECT_TRUE(c.flipped > before.flipped || (c.flipped == before.flipped && c.eps_angle >= before.eps_angle)) << c.name;
+    }
+  }
+  for (size_t i = 0; i < a.candidates.size(); ++i)
+    if (a.candidates[i].corners >= 0 && a.candidates[i].error.empty()) {
+      EXPECT_EQ(listed.count(static_cast<int>(i)), 1u) << a.candidates[i].name;
+    }
   // Without the finer variants: only the six orientations.
   AlignmentOptions plain;
   plain.fine_polycube_vertices = 0;
