@@ -846,7 +846,7 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
       ++more;
       finish_attempts(attempts.size() - 1, options, source, true);
       Attempt& a = *attempts.back();
-      if (!kept->judged().meets_contract() && exact_possible(a) && !a.judged().meets_contract() && !time_limit.spent(progress)) try_exact(&a);
+      if (!kept->judged().meets_contract() && exact_possible(a) && !time_limit.spent(progress)) try_exact(&a);  // (a misses too)
       if (kept->judged().meets_contract() || time_limit.spent(progress)) break;
     }
     report["alignment"]["more_orientations"] = more;
