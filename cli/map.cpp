@@ -642,16 +642,13 @@ int run_map(const MapOptions& options, const GlobalOptions& global) {
         continue;
       }
       if (kept) progress.stage("retry", shortfall() + "finishing " + a.name);
-      if (skip_failures) {
-        try {
-          run_stages(a, stages_source, pass, progress);
-        } catch (const Error& e) {
-          progress.warning(a.name + ": " + e.what());
-          a.finished.reset();
-          continue;
-        }
-      } else {
+      try {
         run_stages(a, stages_source, pass, progress);
+      } catch (const Error& e) {
+        if (!skip_failures) throw;
+        progress.warning(a.name + ": " + e.what());
+        a.finished.reset();
+        continue;
       }
       if (a.finished) a.on_model = on_model_of(a, *a.finished);
       if (!a.finished) {
